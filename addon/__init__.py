@@ -1,0 +1,64 @@
+"""Radiosity for Blender: hierarchical radiosity with perceptual refinement.
+
+Solves the diffuse global illumination of a scene with hierarchical radiosity,
+refined by a choice of oracles (standard BF, the perceptual oracle of Secchia
+2000, gradient difference), and bakes the result into colour attributes that
+show in the viewport and in renders. The lighting is computed by the native
+module `_radiosity` next to this file; this package is the Blender glue.
+
+Scripting: `scene.radiosity` holds the settings, `bpy.ops.radiosity.solve()`
+solves (also in `blender --background`).
+"""
+
+bl_info = {
+    "name": "Radiosity",
+    "author": "Radiosity for Blender contributors",
+    "version": (0, 1, 0),
+    "blender": (3, 4, 0),
+    "location": "Properties > Render > Radiosity",
+    "description": "Hierarchical radiosity with perceptual refinement, baked into colour attributes",
+    "category": "Render",
+}
+
+if "bpy" in locals():
+    # Re-running register after F8 / "Reload Scripts": pick up edited modules.
+    import importlib
+
+    for _name in ("native", "properties", "operators", "ui"):
+        if _name in locals():
+            importlib.reload(locals()[_name])
+
+import bpy
+from bpy.props import PointerProperty
+
+from . import native, operators, properties, ui
+
+# Registration order matters: a PropertyGroup before the group that points to it.
+classes = (
+    properties.RadiosityStats,
+    properties.RadiositySettings,
+    operators.RADIOSITY_OT_solve,
+    ui.RENDER_PT_radiosity,
+)
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+    bpy.types.Scene.radiosity = PointerProperty(
+        type=properties.RadiositySettings,
+        name="Radiosity",
+        description="Radiosity solver settings",
+    )
+    # Try the native module now so the panel can say at once if it is unusable;
+    # registration itself never depends on it.
+    try:
+        native.load()
+    except native.NativeUnavailable as err:
+        print("Radiosity:", err)
+
+
+def unregister():
+    del bpy.types.Scene.radiosity
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,191 @@
+"""Scene settings of the Radiosity add-on: `scene.radiosity`.
+
+What the user chooses (oracle, quality, budgets, visibility, output) and what
+the last solve reported. Identifiers of enum items are part of the scripting
+interface (`scene.radiosity.oracle = 'PERCEPTUAL'`); tests and batch scripts
+rely on them, so they do not change.
+"""
+
+import bpy
+from bpy.props import (
+    BoolProperty,
+    EnumProperty,
+    FloatProperty,
+    IntProperty,
+    PointerProperty,
+    StringProperty,
+)
+from bpy.types import PropertyGroup
+
+ORACLE_ITEMS = (
+    ('STANDARD', "Standard",
+     "Refine where the form factor varies over the receiver times the emitter's "
+     "power (Hanrahan et al. BF refinement)"),
+    ('PERCEPTUAL', "Perceptual",
+     "Refine where linear interpolation of radiance across an element would be "
+     "visibly wrong, judged from irradiance gradients (Secchia 2000)"),
+    ('GRADIENT', "Gradient Difference",
+     "Refine where the irradiance gradient changes across the receiver"),
+)
+
+VISIBILITY_ITEMS = (
+    ('EXACT', "Exact",
+     "Clip each emitter against its occluders as seen from every sample point; "
+     "exact shadows and gradients, slower"),
+    ('SAMPLED', "Sampled",
+     "Estimate the visible fraction of each emitter with shadow rays; faster, "
+     "noisier penumbrae, gradients ignore occluders"),
+)
+
+OUTPUT_ITEMS = (
+    ('REFINED', "Refined Meshes",
+     "Write new meshes that carry the adaptive refinement into a 'Radiosity' "
+     "collection, leaving the originals untouched"),
+    ('ORIGINAL', "Original Meshes",
+     "Write a face-corner 'Radiosity' colour attribute onto the original meshes, "
+     "without refinement"),
+    ('BOTH', "Both",
+     "Write refined meshes and the attribute on the original meshes"),
+)
+
+
+class RadiosityStats(PropertyGroup):
+    """What the last solve of this scene reported. Written by the solver, shown read-only."""
+
+    valid: BoolProperty(
+        name="Solved",
+        description="Whether this scene has been solved since the settings were created",
+        default=False,
+    )
+    status: StringProperty(
+        name="Status",
+        description="How the last solve ended (converged, budget reached, cancelled)",
+    )
+    oracle: StringProperty(
+        name="Oracle",
+        description="Refinement oracle used by the last solve",
+    )
+    elements: IntProperty(
+        name="Elements",
+        description="Leaf elements of the hierarchy after the last solve",
+        min=0,
+    )
+    links: IntProperty(
+        name="Links",
+        description="Interaction links after the last solve",
+        min=0,
+    )
+    iterations: IntProperty(
+        name="Iterations",
+        description="Refine-gather-push/pull iterations of the last solve",
+        min=0,
+    )
+    seconds: FloatProperty(
+        name="Time",
+        description="Wall-clock time of the last solve",
+        min=0.0,
+        unit='TIME_ABSOLUTE',
+    )
+    warning: StringProperty(
+        name="Warning",
+        description="What the last solve could not model (for example point lights)",
+    )
+
+    def clear(self):
+        """Forget the last solve."""
+        self.valid = False
+        self.status = self.oracle = self.warning = ""
+        self.elements = self.links = self.iterations = 0
+        self.seconds = 0.0
+
+
+class RadiositySettings(PropertyGroup):
+    """Radiosity solver settings of a scene."""
+
+    oracle: EnumProperty(
+        name="Oracle",
+        description="How the solver decides where to refine the mesh",
+        items=ORACLE_ITEMS,
+        default='PERCEPTUAL',
+    )
+    quality: FloatProperty(
+        name="Quality",
+        description=(
+            "How finely to refine, from 0 (coarse and fast) to 1 (fine and slow). "
+            "Each oracle maps it to its own refinement threshold relative to the "
+            "scene's emitted power and area, so the same value gives comparable "
+            "results in scenes of any scale or brightness"
+        ),
+        min=0.0,
+        max=1.0,
+        default=0.5,
+        subtype='FACTOR',
+    )
+    max_elements: IntProperty(
+        name="Max Elements",
+        description=(
+            "Stop refining when the hierarchy has this many leaf elements and "
+            "keep the best solution so far (0 for no limit)"
+        ),
+        min=0,
+        default=0,
+    )
+    time_budget: FloatProperty(
+        name="Time Budget",
+        description=(
+            "Stop refining after this many seconds and keep the best solution "
+            "so far (0 for no limit)"
+        ),
+        min=0.0,
+        default=0.0,
+        unit='TIME_ABSOLUTE',
+    )
+    visibility: EnumProperty(
+        name="Visibility",
+        description="How occlusion between surfaces is computed",
+        items=VISIBILITY_ITEMS,
+        default='EXACT',
+    )
+    rays: IntProperty(
+        name="Rays",
+        description="Shadow rays per sample point and emitter for sampled visibility",
+        min=1,
+        soft_max=256,
+        max=4096,
+        default=16,
+    )
+    bounces: IntProperty(
+        name="Bounces",
+        description=(
+            "Number of refine-gather-push/pull iterations (0 to iterate until "
+            "the radiance converges)"
+        ),
+        min=0,
+        soft_max=16,
+        default=0,
+    )
+    output: EnumProperty(
+        name="Output",
+        description="Where the solution is written",
+        items=OUTPUT_ITEMS,
+        default='REFINED',
+    )
+    show_wireframe: BoolProperty(
+        name="Show Elements",
+        description="Show the edges of the refined elements in the viewport",
+        default=False,
+    )
+    stats: PointerProperty(type=RadiosityStats)
+
+    def solver_options(self):
+        """The settings as plain values, the form the native solver takes."""
+        return {
+            "oracle": self.oracle.lower(),
+            "quality": self.quality,
+            "max_elements": self.max_elements,
+            "time_budget": self.time_budget,
+            "visibility": self.visibility.lower(),
+            "rays": self.rays,
+            "bounces": self.bounces,
+        }
+

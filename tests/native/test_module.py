@@ -1,0 +1,49 @@
+"""The compiled `_radiosity` module loads in plain Python and says which version it is.
+
+Run by tests/run_tests.py with build/addon/radiosity on sys.path, under Debian's
+/usr/bin/python3 (the interpreter Blender runs), without Blender.
+"""
+
+import pathlib
+import re
+import sys
+import tomllib
+import unittest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+def project_version():
+    """VERSION of project() in the top-level CMakeLists.txt, the one source of truth."""
+    text = (ROOT / "CMakeLists.txt").read_text(encoding="utf-8")
+    return re.search(r"project\(\s*radiosity\s+VERSION\s+([0-9.]+)", text).group(1)
+
+
+class ModuleTest(unittest.TestCase):
+    def test_imports_from_the_assembled_addon(self):
+        import _radiosity
+
+        path = pathlib.Path(_radiosity.__file__)
+        self.assertEqual(path.parent.name, "radiosity", "expected build/addon/radiosity/")
+        tag = "cpython-%d%d" % sys.version_info[:2]
+        self.assertIn(tag, path.name, "module built for another Python than this one")
+
+    def test_version_matches_project_and_addon(self):
+        import _radiosity
+
+        self.assertIsInstance(_radiosity.__version__, str)
+        self.assertRegex(_radiosity.__version__, r"^\d+\.\d+\.\d+$")
+        self.assertEqual(_radiosity.__version__, project_version())
+        # The manifest is copied next to the module; a release bumps all of them.
+        manifest = pathlib.Path(_radiosity.__file__).parent / "blender_manifest.toml"
+        with open(manifest, "rb") as f:
+            self.assertEqual(tomllib.load(f)["version"], _radiosity.__version__)
+
+    def test_has_docstring(self):
+        import _radiosity
+
+        self.assertTrue(_radiosity.__doc__)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,246 @@
+#!/usr/bin/env python3
+"""Runs every test of the project and prints one summary line.
+
+Three kinds of tests, run in this order:
+  ctest           the C++ unit tests registered with CTest in the build dir
+  native/test_*   unittest files for the `_radiosity` module, run by /usr/bin/python3
+                  with build/addon/radiosity on sys.path (no Blender)
+  blender/test_*  unittest files run inside `blender --background --factory-startup`,
+                  one Blender process per file, with the add-on registered
+
+One line per group (name, passed, failed, seconds), the output of failures, and
+a last line `N passed, M failed`. Exits non-zero if anything failed, errored or
+crashed, or if nothing ran at all.
+
+    /usr/bin/python3 tests/run_tests.py --build build --blender blender [-k PATTERN] [-v]
+"""
+
+import argparse
+import concurrent.futures
+import fnmatch
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+TESTS = ROOT / "tests"
+RUNNER = TESTS / "unittest_runner.py"
+LOG_TAIL = 80  # lines of a crashed process' output worth showing
+
+
+class Outcome:
+    """The result of one group: counts and what to show when it failed."""
+
+    def __init__(self, name, passed=0, failed=0, seconds=0.0, details="", ran=True):
+        self.name, self.passed, self.failed = name, passed, failed
+        self.seconds, self.details, self.ran = seconds, details, ran
+
+
+def parse_args():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--build", default="build", help="CMake build directory")
+    parser.add_argument("--blender", default="blender", help="Blender executable")
+    parser.add_argument("--python", default="/usr/bin/python3",
+                        help="interpreter for tests/native (Blender's Python version)")
+    parser.add_argument("-k", dest="patterns", action="append", default=[],
+                        help="run only groups or tests whose name matches: a substring, "
+                             "or a glob if it has '*' (repeatable; a test runs if any matches)")
+    parser.add_argument("-j", "--jobs", type=int, default=1,
+                        help="Python test files to run at once (ctest always uses all cores)")
+    parser.add_argument("--timeout", type=float, default=900,
+                        help="seconds before one test process counts as hung")
+    parser.add_argument("-v", "--verbose", action="store_true",
+                        help="show every process' output, not only failures'")
+    return parser.parse_args()
+
+
+def matches(name, patterns):
+    """unittest's -k rule, used everywhere: a glob if it has '*', else a substring."""
+    if not patterns:
+        return True
+    return any(fnmatch.fnmatchcase(name, p) if "*" in p else p in name for p in patterns)
+
+
+def head(text, lines=LOG_TAIL // 2):
+    """The start of a test's output, where the first failure is."""
+    rows = text.rstrip().splitlines()
+    suffix = ["[... %d more lines]" % (len(rows) - lines)] if len(rows) > lines else []
+    return "\n".join(rows[:lines] + suffix)
+
+
+def tail(text, lines=LOG_TAIL):
+    rows = text.rstrip().splitlines()
+    cut = rows[-lines:]
+    prefix = ["[... %d earlier lines]" % (len(rows) - lines)] if len(rows) > lines else []
+    return "\n".join(prefix + cut)
+
+
+# --- ctest ------------------------------------------------------------------------
+
+def ctest_regex(pattern):
+    """The -k rule as a CTest regular expression (searched, like a substring)."""
+    if "*" not in pattern:
+        return re.escape(pattern)
+    return "^" + ".*".join(re.escape(part) for part in pattern.split("*")) + "$"
+
+
+def run_ctest(build, patterns, timeout, verbose):
+    """CTest with a JUnit report; counts come from the XML, not from its text output."""
+    name = "ctest"
+    if not (build / "CTestTestfile.cmake").exists():
+        return Outcome(name, failed=1, details="no CTestTestfile.cmake in %s: build first (make build)" % build)
+    junit = build / "ctest-junit.xml"
+    junit.unlink(missing_ok=True)
+    cmd = ["ctest", "--test-dir", str(build), "--output-junit", str(junit),
+           "-j", str(os.cpu_count() or 1), "--timeout", str(int(timeout))]
+    # A pattern that names the group selects all of it; otherwise it filters test names.
+    if patterns and not matches(name, patterns):
+        cmd += ["-R", "|".join(ctest_regex(p) for p in patterns)]
+    start = time.perf_counter()
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout * 4)
+    seconds = time.perf_counter() - start
+    output = proc.stdout + proc.stderr
+    if "No tests were found" in output:
+        return Outcome(name, seconds=seconds, ran=False, details=output if verbose else "")
+    try:
+        root = ET.parse(junit).getroot()
+    except (OSError, ET.ParseError) as err:
+        return Outcome(name, failed=1, seconds=seconds,
+                       details="ctest wrote no readable JUnit report (%s); exit code %d\n%s"
+                               % (err, proc.returncode, tail(output)))
+    passed = failed = 0
+    reports = []
+    for case in root.iter("testcase"):
+        status = case.get("status", "")
+        if status == "disabled":
+            continue
+        # CTest marks run-and-passed "run", failures "fail", missing executables "notrun".
+        if status == "run" and case.find("failure") is None:
+            passed += 1
+        else:
+            failed += 1
+            reports.append("%s (%s)\n%s" % (case.get("name"), status,
+                                             head(case.findtext("system-out") or "")))
+    if proc.returncode != 0 and failed == 0:
+        failed = 1  # ctest itself failed (for example a test binary that would not start)
+        reports.append("ctest exited with code %d\n%s" % (proc.returncode, tail(output)))
+    details = "\n".join(reports) if failed else (output if verbose else "")
+    return Outcome(name, passed, failed, seconds, details)
+
+
+# --- Python test files ---------------------------------------------------------------
+
+def run_unittest_file(name, cmd, json_out, timeout, verbose):
+    """Run one file through unittest_runner.py and read its JSON report."""
+    start = time.perf_counter()
+    try:
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout,
+                              stdin=subprocess.DEVNULL)
+        output, code = proc.stdout + proc.stderr, proc.returncode
+    except subprocess.TimeoutExpired as err:
+        output = err.stdout.decode(errors="replace") if err.stdout else ""
+        output, code = output + "\n[timed out after %d s]" % timeout, None
+    except OSError as err:  # for example Blender not installed
+        output, code = "could not start %s: %s" % (cmd[0], err), None
+    seconds = time.perf_counter() - start
+    try:
+        report = json.loads(Path(json_out).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        report = None
+
+    if report is None:
+        return Outcome(name, failed=1, seconds=seconds,
+                       details="process ended (exit code %s) without writing results:\n%s"
+                               % (code, tail(output)))
+    failed = report["failed"]
+    parts = ["%s\n%s" % (f["id"], f["traceback"].rstrip()) for f in report["failures"]]
+    if code != 0 and failed == 0:
+        # All tests passed, yet the process did not exit cleanly (for example a crash
+        # while Blender shut down): that is a failure too.
+        failed = 1
+        parts.append("process exited with code %s after the tests passed" % code)
+    if failed and output.strip():
+        parts.append("--- process output ---\n" + tail(output))
+    elif verbose:
+        parts.append(report.get("log", "") + output)
+    passed = report["passed"]
+    ran = passed + failed + report["skipped"] > 0
+    return Outcome(name, passed, failed, seconds, "\n".join(parts), ran=ran)
+
+
+def native_command(args, build, testfile, json_out, patterns):
+    return [args.python, str(RUNNER), "--path", str(build / "addon" / "radiosity"),
+            *pattern_options(patterns), str(testfile), json_out]
+
+
+def blender_command(args, build, testfile, json_out, patterns):
+    return [args.blender, "--background", "--factory-startup", "--python-exit-code", "1",
+            "--python", str(RUNNER), "--",
+            "--path", str(build / "addon"), "--register", "radiosity",
+            *pattern_options(patterns), str(testfile), json_out]
+
+
+def pattern_options(patterns):
+    return [option for p in patterns for option in ("-k", p)]
+
+
+def python_jobs(args, build, tmp):
+    """(name, command, json path) of every selected Python test file."""
+    jobs = []
+    for kind, make_cmd in (("native", native_command), ("blender", blender_command)):
+        for testfile in sorted((TESTS / kind).glob("test_*.py")):
+            name = "%s/%s" % (kind, testfile.name)
+            json_out = str(Path(tmp) / (name.replace("/", "__") + ".json"))
+            # A pattern naming the file runs all of it; otherwise the runner filters test ids.
+            patterns = [] if matches(name, args.patterns) else args.patterns
+            jobs.append((name, make_cmd(args, build, testfile, json_out, patterns), json_out))
+    return jobs
+
+
+# --- Reporting -------------------------------------------------------------------
+
+def print_outcome(outcome):
+    if not outcome.ran and not outcome.failed:
+        print("--   %-34s no tests selected" % outcome.name, flush=True)
+        return
+    mark = "FAIL" if outcome.failed else "ok"
+    print("%-4s %-34s %4d passed %4d failed %7.1f s"
+          % (mark, outcome.name, outcome.passed, outcome.failed, outcome.seconds), flush=True)
+    if outcome.details:
+        print("\n".join("     | " + line for line in outcome.details.splitlines()), flush=True)
+
+
+def main():
+    args = parse_args()
+    build = Path(args.build).resolve()
+    outcomes = []
+    ctest = run_ctest(build, args.patterns, args.timeout, args.verbose)
+    print_outcome(ctest)
+    outcomes.append(ctest)
+
+    with tempfile.TemporaryDirectory(prefix="radiosity-tests-") as tmp:
+        jobs = python_jobs(args, build, tmp)
+        with concurrent.futures.ThreadPoolExecutor(max(1, args.jobs)) as pool:
+            futures = [pool.submit(run_unittest_file, name, cmd, json_out, args.timeout, args.verbose)
+                       for name, cmd, json_out in jobs]
+            for future in futures:  # in a fixed order, whatever finishes first
+                outcome = future.result()
+                print_outcome(outcome)
+                outcomes.append(outcome)
+
+    passed = sum(o.passed for o in outcomes)
+    failed = sum(o.failed for o in outcomes)
+    if passed + failed == 0:
+        print("nothing ran: no test matched %s" % " ".join(args.patterns or ["(all)"]))
+    print("%d passed, %d failed" % (passed, failed))
+    return 1 if failed or passed == 0 else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
