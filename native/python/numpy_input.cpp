@@ -1,0 +1,110 @@
+#include "python/numpy_input.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace py = pybind11;
+
+namespace radiosity::python {
+namespace {
+
+std::string shape_string(const py::array& a) {
+  std::ostringstream out;
+  out << "(";
+  for (py::ssize_t i = 0; i < a.ndim(); ++i) out << (i ? ", " : "") << a.shape(i);
+  out << (a.ndim() == 1 ? ",)" : ")");
+  return out.str();
+}
+
+std::string expected_string(const std::vector<py::ssize_t>& shape) {
+  std::ostringstream out;
+  out << "(";
+  for (size_t i = 0; i < shape.size(); ++i) {
+    out << (i ? ", " : "");
+    if (shape[i] < 0) out << (i == 0 ? "n" : "k"); else out << shape[i];
+  }
+  out << (shape.size() == 1 ? ",)" : ")");
+  return out.str();
+}
+
+}  // namespace
+
+py::array_t<double, py::array::c_style | py::array::forcecast> read_array(
+    const py::handle& object, const std::string& name, std::vector<py::ssize_t> shape) {
+  if (object.is_none()) throw std::invalid_argument(name + " must be an array, got None");
+  py::array_t<double, py::array::c_style | py::array::forcecast> a;
+  try {
+    a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(object);
+  } catch (const py::error_already_set&) {
+    a = {};
+  }
+  if (!a) throw std::invalid_argument(name + " must be convertible to a float64 array");
+  bool ok = a.ndim() == static_cast<py::ssize_t>(shape.size());
+  for (size_t i = 0; ok && i < shape.size(); ++i) {
+    ok = shape[i] < 0 || a.shape(static_cast<py::ssize_t>(i)) == shape[i];
+  }
+  if (!ok) {
+    throw std::invalid_argument(name + " must have shape " + expected_string(shape) + ", got " +
+                                shape_string(a));
+  }
+  require_finite(a.data(), static_cast<size_t>(a.size()), name);
+  return a;
+}
+
+void require_finite(const double* data, size_t count, const std::string& name) {
+  for (size_t i = 0; i < count; ++i) {
+    if (!std::isfinite(data[i])) {
+      throw std::invalid_argument(name + " contains a non-finite value (NaN or infinity) at flat index " +
+                                  std::to_string(i));
+    }
+  }
+}
+
+dvec3 read_vec3(const py::handle& object, const std::string& name) {
+  const auto a = read_array(object, name, {3});
+  return {a.at(0), a.at(1), a.at(2)};
+}
+
+dvec3 read_unit_vec3(const py::handle& object, const std::string& name) {
+  const dvec3 v = read_vec3(object, name);
+  const double length = glm::length(v);
+  if (!(length > 0.0) || !std::isfinite(length)) {
+    throw std::invalid_argument(name + " must be a non-zero vector");
+  }
+  return v / length;
+}
+
+std::vector<dvec3> read_polygon(const py::handle& object, const std::string& name) {
+  const auto a = read_array(object, name, {-1, 3});
+  const size_t n = static_cast<size_t>(a.shape(0));
+  if (n < 3) {
+    throw std::invalid_argument(name + " needs at least 3 vertices, got " + std::to_string(n));
+  }
+  std::vector<dvec3> polygon(n);
+  const double* p = a.data();
+  for (size_t i = 0; i < n; ++i) polygon[i] = {p[3 * i], p[3 * i + 1], p[3 * i + 2]};
+  // Zero-area and collinear polygons are rejected here, with the reason, so the
+  // kernels never see them (MATH.md s3).
+  dvec3 area_normal(0.0);
+  double diameter = 0.0;
+  for (size_t i = 1; i + 1 < n; ++i) {
+    area_normal += glm::cross(polygon[i] - polygon[0], polygon[i + 1] - polygon[0]);
+  }
+  for (size_t i = 1; i < n; ++i) diameter = std::max(diameter, glm::length(polygon[i] - polygon[0]));
+  if (!(glm::length(area_normal) > 1e-12 * diameter * diameter) || !(diameter > 0.0)) {
+    throw std::invalid_argument(name + " has zero area (collinear or coincident vertices)");
+  }
+  return polygon;
+}
+
+py::array_t<double> to_numpy(const dvec3& v) {
+  py::array_t<double> out(3);
+  auto w = out.mutable_unchecked<1>();
+  w(0) = v.x;
+  w(1) = v.y;
+  w(2) = v.z;
+  return out;
+}
+
+}  // namespace radiosity::python
