@@ -166,7 +166,8 @@ def run_unittest_file(name, cmd, json_out, timeout, verbose):
         failed = 1
         parts.append("process exited with code %s after the tests passed" % code)
     if failed and output.strip():
-        parts.append("--- process output ---\n" + tail(output))
+        # The tracebacks above say what failed; the end of the log gives context.
+        parts.append("--- end of process output ---\n" + tail(output, LOG_TAIL // 4))
     elif verbose:
         parts.append(report.get("log", "") + output)
     passed = report["passed"]

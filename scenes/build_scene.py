@@ -1,0 +1,41 @@
+"""Builds one bundled scene and saves it (runs inside Blender).
+
+    blender -b --factory-startup --python scenes/build_scene.py -- NAME OUT.blend
+
+NAME is one of catalog.SCENES; each has a module NAME.py here with build(scene).
+"""
+
+import importlib
+import os
+import sys
+
+import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import catalog  # noqa: E402  (needs the path above)
+import scene_kit  # noqa: E402
+
+
+def build(name, scene):
+    """Fill `scene` (empty) with the scene called `name`."""
+    if name not in catalog.SCENES:
+        raise ValueError("unknown scene %r; known: %s" % (name, ", ".join(catalog.SCENES)))
+    importlib.import_module(name).build(scene)
+
+
+def main(argv):
+    args = argv[argv.index("--") + 1:] if "--" in argv else []
+    if len(args) != 2:
+        sys.exit("usage: blender -b --factory-startup --python build_scene.py -- NAME OUT.blend")
+    name, out = args
+    scene = scene_kit.empty_file()
+    scene.name = name
+    build(name, scene)
+    os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
+    bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(out))
+    print("built scene %r: %s" % (name, out))
+
+
+if __name__ == "__main__":
+    main(sys.argv)

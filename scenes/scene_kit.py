@@ -1,0 +1,152 @@
+"""Shared pieces of the scene builders (runs inside Blender).
+
+Geometry is built from numpy arrays of quads with outward (for objects) or
+inward (for rooms) normals, so every face's front side is the side that sees
+the rest of the scene. Materials are plain: Principled BSDF with a base colour
+and no specular layer (a diffuse surface, the scenes radiosity models), and an
+Emission shader for lights. Render settings make a Cycles render of the scene a
+reference for the radiosity solution: CPU, Standard view transform, enough
+diffuse bounces, no clamping.
+"""
+
+import bpy
+import numpy as np
+from mathutils import Vector
+
+# Corners of the unit box, index = x + 2 y + 4 z, each coordinate -0.5 or +0.5.
+_BOX_CORNERS = np.array([[x, y, z] for z in (-0.5, 0.5) for y in (-0.5, 0.5) for x in (-0.5, 0.5)])
+# Its faces, counter-clockwise seen from outside.
+BOX_FACES = {
+    "bottom": (0, 2, 3, 1),
+    "top": (4, 5, 7, 6),
+    "front": (0, 1, 5, 4),   # -y
+    "back": (2, 6, 7, 3),    # +y
+    "left": (0, 4, 6, 2),    # -x
+    "right": (1, 3, 7, 5),   # +x
+}
+
+
+def empty_file():
+    """Start from an empty file (no factory cube, light or camera)."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    return bpy.context.scene
+
+
+def box(size, omit=()):
+    """(vertices, quads) of an axis-aligned box centred on the origin, normals out.
+
+    `omit` names faces that touch other surfaces (a leg's top under a table);
+    leaving them out keeps coincident, invisible faces out of the solve.
+    """
+    verts = _BOX_CORNERS * np.asarray(size, dtype=float)
+    quads = np.array([f for name, f in BOX_FACES.items() if name not in omit])
+    return verts, quads
+
+
+def quad(origin, u, v):
+    """(vertices, quads) of the parallelogram origin + [0,1] u + [0,1] v; normal u x v."""
+    o, u, v = (np.asarray(a, dtype=float) for a in (origin, u, v))
+    return np.array([o, o + u, o + u + v, o + v]), np.array([[0, 1, 2, 3]])
+
+
+def room_walls(lo, hi):
+    """The six inner faces of the room between corners lo and hi, normals inward.
+
+    Returns {name: (vertices, quads)} for floor, ceiling and the walls
+    left (-x), right (+x), front (-y), back (+y).
+    """
+    (x0, y0, z0), (x1, y1, z1) = lo, hi
+    dx, dy, dz = x1 - x0, y1 - y0, z1 - z0
+    return {
+        "Floor": quad((x0, y0, z0), (dx, 0, 0), (0, dy, 0)),
+        "Ceiling": quad((x0, y0, z1), (0, dy, 0), (dx, 0, 0)),
+        "Wall.Left": quad((x0, y0, z0), (0, dy, 0), (0, 0, dz)),
+        "Wall.Right": quad((x1, y0, z0), (0, 0, dz), (0, dy, 0)),
+        "Wall.Front": quad((x0, y0, z0), (0, 0, dz), (dx, 0, 0)),
+        "Wall.Back": quad((x0, y1, z0), (dx, 0, 0), (0, 0, dz)),
+    }
+
+
+def ceiling_light(center, size_x, size_y):
+    """(vertices, quads) of a rectangle facing down (-z) centred at `center`."""
+    cx, cy, cz = center
+    return quad((cx - size_x / 2, cy - size_y / 2, cz), (0, size_y, 0), (size_x, 0, 0))
+
+
+def add_mesh(scene, name, geometry, material, location=(0, 0, 0), rotation=(0, 0, 0)):
+    """Link a new object made of `geometry` = (vertices, quads) to the scene."""
+    verts, quads = geometry
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(verts.tolist(), [], quads.tolist())
+    mesh.validate()
+    mesh.materials.append(material)
+    obj = bpy.data.objects.new(name, mesh)
+    obj.location = location
+    obj.rotation_euler = rotation
+    scene.collection.objects.link(obj)
+    return obj
+
+
+def diffuse_material(name, color):
+    """A diffuse material: Principled BSDF with `color` (linear RGB) and no specular."""
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    bsdf.inputs["Base Color"].default_value = (*color, 1.0)
+    bsdf.inputs["Specular"].default_value = 0.0
+    mat.diffuse_color = (*color, 1.0)  # the viewport colour in Solid shading
+    return mat
+
+
+def emission_material(name, strength, color=(1.0, 1.0, 1.0)):
+    """A light: an Emission shader of radiance color x strength, nothing else."""
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    nodes.clear()
+    emission = nodes.new("ShaderNodeEmission")
+    emission.inputs["Color"].default_value = (*color, 1.0)
+    emission.inputs["Strength"].default_value = strength
+    output = nodes.new("ShaderNodeOutputMaterial")
+    output.location = (300, 0)
+    links.new(emission.outputs["Emission"], output.inputs["Surface"])
+    mat.diffuse_color = (*color, 1.0)
+    return mat
+
+
+def add_camera(scene, location, target, lens=20.0):
+    """A camera at `location` looking at `target`, set as the scene camera."""
+    data = bpy.data.cameras.new("Camera")
+    data.lens = lens
+    data.clip_start = 0.01
+    cam = bpy.data.objects.new("Camera", data)
+    cam.location = location
+    direction = Vector(target) - Vector(location)
+    cam.rotation_euler = direction.to_track_quat('-Z', 'Y').to_euler()
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    return cam
+
+
+def setup_render(scene, resolution=(640, 480), samples=128):
+    """Cycles on the CPU, Standard view transform, a black world."""
+    scene.render.engine = 'CYCLES'
+    scene.cycles.device = 'CPU'
+    scene.cycles.samples = samples
+    # Enough bounces for a closed room to converge, and no clamping: a Cycles
+    # render of the scene is a reference for the radiosity solution.
+    scene.cycles.max_bounces = 32
+    scene.cycles.diffuse_bounces = 32
+    scene.cycles.sample_clamp_indirect = 0.0
+    scene.render.resolution_x, scene.render.resolution_y = resolution
+    scene.render.resolution_percentage = 100
+    scene.view_settings.view_transform = 'Standard'
+    scene.view_settings.look = 'None'
+    scene.view_settings.exposure = 0.0
+    scene.view_settings.gamma = 1.0
+
+    world = bpy.data.worlds.new("World")
+    world.color = (0.0, 0.0, 0.0)
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+    scene.world = world

@@ -1,0 +1,177 @@
+"""The bundled scene builders make what the solver and the demo expect (headless Blender).
+
+Each scene is built into a new scene of this Blender session, then checked:
+quads only, a closed room with inward walls, one emitter facing down, a
+camera inside looking at the occluder, Cycles settings, and a small render
+that is neither black nor blown out.
+"""
+
+import os
+import re
+import sys
+import tempfile
+import unittest
+
+import bpy
+import numpy as np
+from bpy_extras.object_utils import world_to_camera_view
+from mathutils import Vector
+
+SCENES_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scenes")
+sys.path.insert(0, os.path.abspath(SCENES_DIR))
+
+import build_scene  # noqa: E402
+import catalog  # noqa: E402
+
+# The object each scene's camera must see, and that casts the shadow.
+SUBJECT = {"cube": "Cube", "office": "Table.Top"}
+
+
+def objects(scene):
+    """The scene's objects by the name their builder gave them. Blender appends
+    .001, .002 to names already taken in this session (the factory Cube, or the
+    walls of a scene built earlier)."""
+    return {re.sub(r"\.\d{3}$", "", o.name): o for o in scene.objects}
+
+
+def world_polygons(obj):
+    """(centres, normals, areas) of an object's polygons in world space."""
+    mesh = obj.data
+    n = len(mesh.polygons)
+    centres, normals, areas = np.empty(3 * n), np.empty(3 * n), np.empty(n)
+    mesh.polygons.foreach_get("center", centres)
+    mesh.polygons.foreach_get("normal", normals)
+    mesh.polygons.foreach_get("area", areas)
+    m = np.array(obj.matrix_world)
+    centres = centres.reshape(-1, 3) @ m[:3, :3].T + m[:3, 3]
+    normals = normals.reshape(-1, 3) @ np.linalg.inv(m[:3, :3])  # inverse transpose
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    return centres, normals, areas
+
+
+def emission_strength(material):
+    nodes = material.node_tree.nodes if material.use_nodes else []
+    return sum(node.inputs["Strength"].default_value for node in nodes if node.type == 'EMISSION')
+
+
+class SceneBuildersTest(unittest.TestCase):
+    built = {}
+
+    @classmethod
+    def scene(cls, name):
+        """Build `name` once into its own Blender scene."""
+        if name not in cls.built:
+            scene = bpy.data.scenes.new(name)
+            build_scene.build(name, scene)
+            scene.view_layers[0].update()  # evaluate matrix_world of the new objects
+            cls.built[name] = scene
+        return cls.built[name]
+
+    def for_each_scene(self, check):
+        for name in catalog.SCENES:
+            with self.subTest(scene=name):
+                check(name, self.scene(name))
+
+    def test_catalog_has_a_module_per_scene(self):
+        self.assertIn("cube", catalog.SCENES)
+        self.assertIn("office", catalog.SCENES)
+        with self.assertRaises(ValueError):
+            build_scene.build("no_such_scene", bpy.context.scene)
+
+    def test_quads_only(self):
+        def check(name, scene):
+            for obj in scene.objects:
+                if obj.type != 'MESH':
+                    continue
+                sizes = np.empty(len(obj.data.polygons), dtype=np.int32)
+                obj.data.polygons.foreach_get("loop_total", sizes)
+                self.assertTrue(np.all(sizes == 4), obj.name)
+        self.for_each_scene(check)
+
+    def test_room_is_closed_with_inward_walls(self):
+        def check(name, scene):
+            walls = [objects(scene)[n] for n in
+                     ("Floor", "Ceiling", "Wall.Left", "Wall.Right", "Wall.Front", "Wall.Back")]
+            corners = np.array([v.co for w in walls for v in w.data.vertices])
+            lo, hi = corners.min(0), corners.max(0)
+            size = hi - lo
+            total = sum(world_polygons(w)[2].sum() for w in walls)
+            self.assertAlmostEqual(total, 2 * (size[0] * size[1] + size[1] * size[2] + size[0] * size[2]), 6)
+            middle = (lo + hi) / 2
+            for wall in walls:
+                centres, normals, _ = world_polygons(wall)
+                self.assertTrue(np.all(np.einsum("ij,ij->i", normals, middle - centres) > 0), wall.name)
+        self.for_each_scene(check)
+
+    def test_one_emitter_facing_down(self):
+        def check(name, scene):
+            emitters = [o for o in scene.objects if o.type == 'MESH'
+                        and any(emission_strength(m) > 0 for m in o.data.materials)]
+            self.assertEqual(emitters, [objects(scene)["Light"]])
+            _, normals, _ = world_polygons(emitters[0])
+            np.testing.assert_allclose(normals, [[0, 0, -1]] * len(normals), atol=1e-6)
+            self.assertFalse([o.name for o in scene.objects if o.type == 'LIGHT'])
+        self.for_each_scene(check)
+
+    def test_surfaces_are_diffuse_with_valid_reflectance(self):
+        def check(name, scene):
+            for obj in scene.objects:
+                for mat in (obj.data.materials if obj.type == 'MESH' else []):
+                    if emission_strength(mat) > 0:
+                        continue
+                    bsdf = mat.node_tree.nodes["Principled BSDF"]
+                    rho = bsdf.inputs["Base Color"].default_value[:3]
+                    self.assertTrue(all(0 <= c < 1 for c in rho), mat.name)
+                    self.assertEqual(bsdf.inputs["Specular"].default_value, 0.0, mat.name)
+        self.for_each_scene(check)
+        cube = self.scene("cube")
+        left = objects(cube)["Wall.Left"].data.materials[0].diffuse_color
+        right = objects(cube)["Wall.Right"].data.materials[0].diffuse_color
+        self.assertGreater(left[0], 3 * left[1])    # red
+        self.assertGreater(right[1], 2 * right[0])  # green
+
+    def test_camera_inside_looking_at_the_subject(self):
+        def check(name, scene):
+            cam = scene.camera
+            self.assertIsNotNone(cam)
+            walls = [v.co for n in ("Floor", "Ceiling") for v in objects(scene)[n].data.vertices]
+            lo = np.min(np.array(walls), 0)
+            hi = np.max(np.array(walls), 0)
+            self.assertTrue(np.all(lo < np.array(cam.location)) and np.all(np.array(cam.location) < hi))
+            subject = objects(scene)[SUBJECT[name]]
+            x, y, depth = world_to_camera_view(scene, cam, subject.matrix_world.translation)
+            self.assertTrue(0.1 < x < 0.9 and 0.1 < y < 0.9 and depth > 0, (x, y, depth))
+        self.for_each_scene(check)
+
+    def test_render_settings(self):
+        def check(name, scene):
+            self.assertEqual(scene.render.engine, 'CYCLES')
+            self.assertEqual(scene.cycles.device, 'CPU')
+            self.assertEqual(scene.view_settings.view_transform, 'Standard')
+            self.assertEqual(scene.view_settings.look, 'None')
+            self.assertEqual(scene.view_settings.exposure, 0.0)
+        self.for_each_scene(check)
+
+    def test_render_is_well_exposed(self):
+        # A tiny, noisy render is enough to tell black or blown out from well lit.
+        def check(name, scene):
+            scene.render.resolution_percentage = 12
+            scene.cycles.samples = 8
+            scene.cycles.use_denoising = False
+            scene.render.image_settings.file_format = 'OPEN_EXR'  # linear values
+            with tempfile.TemporaryDirectory() as tmp:
+                scene.render.filepath = os.path.join(tmp, name + ".exr")
+                with bpy.context.temp_override(scene=scene):
+                    bpy.ops.render.render(write_still=True, scene=scene.name)
+                image = bpy.data.images.load(scene.render.filepath)
+                pixels = np.empty(len(image.pixels), dtype=np.float32)
+                image.pixels.foreach_get(pixels)
+                bpy.data.images.remove(image)
+            luminance = pixels.reshape(-1, 4)[:, :3] @ np.array([0.2126, 0.7152, 0.0722])
+            self.assertTrue(0.05 < np.median(luminance) < 0.6, np.median(luminance))
+            self.assertLess(np.mean(luminance > 1.0), 0.05)
+        self.for_each_scene(check)
+
+
+if __name__ == "__main__":
+    unittest.main()
