@@ -255,5 +255,218 @@ TEST(VisiblePolygon, GradientMatchesFiniteDifferences) {
   EXPECT_LE(skipped, tested / 10);
 }
 
+// --- Degenerate configurations ------------------------------------------------------
+
+// Finite, F in [0, unoccluded], and (when `samples` > 0) within 4.5 standard errors
+// of Monte Carlo.
+void expect_sane(const dvec3& r, const dvec3& n, const Polygon& emitter,
+                 const std::vector<Triangle>& occluders, int samples, const char* what) {
+  const FormFactorGradient fg = visible_form_factor_gradient(r, n, emitter, occluders);
+  const double unoccluded = form_factor(r, n, emitter);
+  EXPECT_TRUE(std::isfinite(fg.value) && std::isfinite(fg.gradient.x) &&
+              std::isfinite(fg.gradient.y) && std::isfinite(fg.gradient.z))
+      << what;
+  EXPECT_GE(fg.value, 0.0) << what;
+  EXPECT_LE(fg.value, unoccluded) << what;
+  if (samples > 0) {
+    std::mt19937_64 rng(3);
+    const MonteCarlo mc = monte_carlo_form_factor(r, n, emitter, occluders, samples, rng);
+    EXPECT_LT(std::abs(fg.value - mc.mean), 4.5 * mc.standard_error + 1e-12)
+        << what << ": exact " << fg.value << " mc " << mc.mean << " +- " << mc.standard_error;
+  }
+}
+
+// Two triangles of the quad a, b, c, d.
+std::vector<Triangle> quad(const dvec3& a, const dvec3& b, const dvec3& c, const dvec3& d) {
+  return {Triangle{{a, b, c}}, Triangle{{a, c, d}}};
+}
+
+// The 12 triangles of an axis-aligned box, front and back faces all given.
+std::vector<Triangle> box(const dvec3& lo, const dvec3& hi) {
+  const auto corner = [&](int i) {
+    return dvec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
+  };
+  const int faces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
+                           {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+  std::vector<Triangle> out;
+  for (const auto& f : faces) {
+    const auto q = quad(corner(f[0]), corner(f[1]), corner(f[2]), corner(f[3]));
+    out.insert(out.end(), q.begin(), q.end());
+  }
+  return out;
+}
+
+// The same with the structures that make the other vertex kinds: occluders
+// piercing the emitter plane (traces, intrinsic piercing points), closed boxes
+// (shared vertices, parallel edges), and receiver normals tilted so far that the
+// horizon cuts the emitter (fixed horizon vertices).
+TEST(VisiblePolygon, GradientMatchesFiniteDifferencesWithTracesBoxesAndHorizon) {
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  int tested = 0, skipped = 0;
+  double worst = 0.0;
+  for (int i = 0; i < 150; ++i) {
+    Configuration c = random_configuration(rng, 1, 0.3);
+    c.n = glm::normalize(dvec3(0.0, 0.0, 1.0) + random_in_ball(rng, 1.2));
+    if (c.n.z < 0.2) c.n.z = 0.2;
+    c.n = glm::normalize(c.n);
+    const dvec3 centre(0.6 * (uni(rng) - 0.5), 0.6 * (uni(rng) - 0.5), 2.0);
+    c.occluders.push_back(Triangle{{centre + dvec3(-0.3, -0.2, -0.4), centre + dvec3(0.3, -0.1, 0.4),
+                                    centre + random_in_ball(rng, 0.3) - dvec3(0.0, 0.0, 0.3)}});
+    const dvec3 lo = c.r + (0.3 + 0.4 * uni(rng)) * (centre - c.r) - dvec3(0.1, 0.1, 0.1);
+    for (const Triangle& t : box(lo, lo + dvec3(0.1 + 0.2 * uni(rng), 0.1 + 0.2 * uni(rng), 0.2)))
+      c.occluders.push_back(t);
+    const FormFactorGradient fg = visible_form_factor_gradient(c.r, c.n, c.emitter, c.occluders);
+    if (fg.value <= 0.0) continue;
+    const double h = 1e-4;
+    dvec3 fd(0.0), fd_half(0.0);
+    for (int k = 0; k < 3; ++k) {
+      dvec3 e(0.0);
+      e[k] = 1.0;
+      fd[k] = (visible_f(c.r + h * e, c.n, c.emitter, c.occluders) -
+               visible_f(c.r - h * e, c.n, c.emitter, c.occluders)) / (2.0 * h);
+      fd_half[k] = (visible_f(c.r + 0.5 * h * e, c.n, c.emitter, c.occluders) -
+                    visible_f(c.r - 0.5 * h * e, c.n, c.emitter, c.occluders)) / h;
+    }
+    const dvec3 richardson = (4.0 * fd_half - fd) / 3.0;
+    const double scale = std::max(glm::length(richardson), 1e-3);
+    if (glm::length(fd - fd_half) > 1e-5 * scale) {
+      ++skipped;
+      continue;
+    }
+    ++tested;
+    const double error = glm::length(fg.gradient - richardson) / scale;
+    worst = std::max(worst, error);
+    EXPECT_LT(error, 1e-5) << "configuration " << i;
+  }
+  std::printf("gradient vs finite differences (traces, boxes, horizon): %d tested, %d skipped, "
+              "worst relative error %.3g\n", tested, skipped, worst);
+  EXPECT_GE(tested, 100);
+  EXPECT_LE(skipped, tested / 10);
+}
+
+TEST(VisiblePolygon, AlignedOccluderHidesExactlyHalf) {
+  // Projection of the occluder from the centre covers exactly the right half of the
+  // emitter: its edges lie on the emitter's edges (D1 events), and the halves have
+  // equal F by symmetry.
+  const dvec3 r(0.0), n(0.0, 0.0, 1.0);
+  const Polygon emitter = math_emitter();
+  const auto occluder = quad({0.0, -0.25, 1.0}, {0.25, -0.25, 1.0}, {0.25, 0.25, 1.0}, {0.0, 0.25, 1.0});
+  const FormFactorGradient fg = visible_form_factor_gradient(r, n, emitter, occluder);
+  const FormFactorGradient half = form_factor_gradient(
+      r, n, Polygon{{-0.5, -0.5, 2.0}, {-0.5, 0.5, 2.0}, {0.0, 0.5, 2.0}, {0.0, -0.5, 2.0}});
+  EXPECT_NEAR(fg.value, 0.5 * form_factor(r, n, emitter), 1e-15);
+  EXPECT_NEAR(fg.value, half.value, 1e-15);
+  EXPECT_TRUE(std::isfinite(glm::length(fg.gradient)));
+  // Same with the occluder split in two along x = 1/8 and given twice (a closed,
+  // flat mesh): the shared edge and the duplicate change nothing.
+  auto split = quad({0.0, -0.25, 1.0}, {0.125, -0.25, 1.0}, {0.125, 0.25, 1.0}, {0.0, 0.25, 1.0});
+  const auto right = quad({0.125, -0.25, 1.0}, {0.25, -0.25, 1.0}, {0.25, 0.25, 1.0}, {0.125, 0.25, 1.0});
+  split.insert(split.end(), right.begin(), right.end());
+  split.insert(split.end(), occluder.begin(), occluder.end());
+  EXPECT_NEAR(visible_f(r, n, emitter, split), half.value, 1e-15);
+}
+
+TEST(VisiblePolygon, OccluderCrossingTheEmitterPlaneIsClippedThere) {
+  // A triangle reaching behind the emitter occludes like its part in front.
+  const dvec3 r(0.1, 0.05, 0.0), n(0.0, 0.0, 1.0);
+  const Polygon emitter = math_emitter();
+  const Triangle through{{dvec3(-0.2, -0.1, 1.5), dvec3(0.3, -0.1, 2.5), dvec3(0.0, 0.3, 1.5)}};
+  // Its part with z <= 2: the quad (-0.2,-0.1,1.5), (0.05,-0.1,2), (0.15,0.1,2), (0,0.3,1.5).
+  const auto front = quad({-0.2, -0.1, 1.5}, {0.05, -0.1, 2.0}, {0.15, 0.1, 2.0}, {0.0, 0.3, 1.5});
+  const FormFactorGradient a = visible_form_factor_gradient(r, n, emitter, std::vector<Triangle>{through});
+  const FormFactorGradient b = visible_form_factor_gradient(r, n, emitter, front);
+  EXPECT_NEAR(a.value, b.value, 1e-14);
+  EXPECT_NEAR(glm::length(a.gradient - b.gradient), 0.0, 1e-12);
+  EXPECT_LT(a.value, form_factor(r, n, emitter));
+  expect_sane(r, n, emitter, {through}, 200000, "crossing the emitter plane");
+}
+
+TEST(VisiblePolygon, DegenerateConfigurations) {
+  const dvec3 r(0.03, -0.02, 0.0);
+  const dvec3 n = glm::normalize(dvec3(0.1, -0.2, 1.0));
+  const Polygon emitter = math_emitter();
+  const double unoccluded = form_factor(r, n, emitter);
+
+  // Touching the emitter: an edge lying on the emitter, inside it.
+  expect_sane(r, n, emitter, {Triangle{{dvec3(-0.3, 0.0, 2.0), dvec3(0.2, 0.1, 2.0), dvec3(0.0, 0.0, 1.4)}}},
+              200000, "edge on the emitter");
+  // Touching the emitter at a vertex only, and along the emitter's own edge.
+  expect_sane(r, n, emitter, {Triangle{{dvec3(0.0, 0.0, 2.0), dvec3(0.3, 0.1, 1.5), dvec3(-0.1, 0.3, 1.6)}}},
+              200000, "vertex on the emitter");
+  expect_sane(r, n, emitter, {Triangle{{dvec3(-0.5, -0.5, 2.0), dvec3(0.5, -0.5, 2.0), dvec3(0.0, 0.0, 1.5)}}},
+              200000, "edge on the emitter's edge");
+  // Touching the receiver: a vertex at r, an edge through r (planes holding r
+  // project to segments and hide nothing of positive measure).
+  expect_sane(r, n, emitter, {Triangle{{r, dvec3(0.2, 0.1, 1.0), dvec3(0.0, 0.3, 1.2)}}}, 200000,
+              "vertex at the receiver");
+  EXPECT_NEAR(visible_f(r, n, emitter, {Triangle{{r - dvec3(0.5, 0, 0), r + dvec3(0.5, 0, 0), dvec3(0.0, 0.1, 1.5)}}}),
+              unoccluded, 1e-15);
+  // A triangle near the receiver, reaching below and behind it.
+  expect_sane(r, n, emitter, {Triangle{{dvec3(-0.5, -0.4, -0.3), dvec3(0.3, 0.6, -0.3), dvec3(0.1, 0.0, 0.2)}}},
+              200000, "through the receiver's plane");
+  // Coplanar with the emitter (a neighbour or an overlapping face): hides nothing.
+  EXPECT_EQ(visible_f(r, n, emitter, quad({-1, -1, 2}, {1, -1, 2}, {1, 1, 2}, {-1, 1, 2})), unoccluded);
+  // Coplanar with the receiver's tangent plane, and holding r.
+  EXPECT_NEAR(visible_f(r, n, emitter, {Triangle{{r + dvec3(1, 0, -0.1), r + dvec3(-1, 1, 0.2), r + dvec3(-1, -1, 0.0)}}}),
+              unoccluded, 1e-15);
+  // Behind the emitter, behind the receiver: nothing.
+  EXPECT_EQ(visible_f(r, n, emitter, quad({-1, -1, 2.5}, {1, -1, 2.5}, {1, 1, 2.5}, {-1, 1, 2.5})), unoccluded);
+  EXPECT_EQ(visible_f(r, n, emitter, quad({-1, -1, -0.5}, {1, -1, -0.5}, {1, 1, -0.5}, {-1, 1, -0.5})), unoccluded);
+  // A floor-to-ceiling blocker larger than the pyramid: all hidden.
+  const auto wall = quad({-5, -5, 1}, {5, -5, 1}, {5, 5, 1}, {-5, 5, 1});
+  const FormFactorGradient hidden = visible_form_factor_gradient(r, n, emitter, wall);
+  EXPECT_EQ(hidden.value, 0.0);
+  EXPECT_EQ(hidden.gradient, dvec3(0.0));
+  // A tiny occluder changes almost nothing and stays finite.
+  const double tiny = visible_f(r, n, emitter, {Triangle{{dvec3(0, 0, 1), dvec3(1e-9, 0, 1), dvec3(0, 1e-9, 1)}}});
+  EXPECT_LE(tiny, unoccluded);
+  EXPECT_NEAR(tiny, unoccluded, 1e-15);
+  // Closed meshes, front and back faces: a box in the way, boxes overlapping.
+  expect_sane(r, n, emitter, box({0.0, -0.1, 0.8}, {0.3, 0.2, 1.2}), 200000, "box");
+  std::vector<Triangle> boxes = box({0.0, -0.1, 0.8}, {0.3, 0.2, 1.2});
+  for (const Triangle& t : box({-0.2, 0.0, 1.0}, {0.1, 0.3, 1.5})) boxes.push_back(t);
+  for (const Triangle& t : box({-0.1, -0.3, 0.5}, {0.2, 0.0, 0.9})) boxes.push_back(t);
+  expect_sane(r, n, emitter, boxes, 200000, "three overlapping boxes");
+  // A box that covers the whole pyramid: nothing visible.
+  EXPECT_EQ(visible_f(r, n, emitter, box({-2, -2, 0.5}, {2, 2, 1.5})), 0.0);
+  // Receiver on the emitter plane and behind it.
+  EXPECT_EQ(visible_f(dvec3(0.1, 0.1, 2.0), n, emitter, {math_occluder()}), 0.0);
+  EXPECT_EQ(visible_f(dvec3(0.1, 0.1, 3.0), n, emitter, {math_occluder()}), 0.0);
+}
+
+TEST(VisiblePolygon, ManyOverlappingOccluders) {
+  std::mt19937_64 rng(19);
+  for (int i = 0; i < 4; ++i) {
+    Configuration c = random_configuration(rng, 40, 0.2);
+    // Add copies, sharing vertices and edges with the originals.
+    for (int k = 0; k < 10; ++k) {
+      Triangle t = c.occluders[k];
+      t.v[2] = c.occluders[k + 10].v[0];
+      c.occluders.push_back(t);
+    }
+    expect_sane(c.r, c.n, c.emitter, c.occluders, 200000, "many occluders");
+  }
+}
+
+TEST(VisiblePolygon, ScaleInvariance) {
+  const dvec3 r(0.03, -0.02, 0.0);
+  const dvec3 n = glm::normalize(dvec3(0.1, -0.2, 1.0));
+  const Polygon emitter = math_emitter();
+  std::vector<Triangle> occluders = box({0.0, -0.1, 0.8}, {0.3, 0.2, 1.2});
+  occluders.push_back(math_occluder());
+  const FormFactorGradient base = visible_form_factor_gradient(r, n, emitter, occluders);
+  for (const double scale : {1e-6, 1e-3, 1e3, 1e6}) {
+    Polygon e = emitter;
+    for (dvec3& v : e) v *= scale;
+    std::vector<Triangle> o = occluders;
+    for (Triangle& t : o)
+      for (dvec3& v : t.v) v *= scale;
+    const FormFactorGradient fg = visible_form_factor_gradient(r * scale, n, e, o);
+    EXPECT_NEAR(fg.value, base.value, 1e-13 * base.value) << scale;
+    EXPECT_NEAR(glm::length(fg.gradient * scale - base.gradient), 0.0, 1e-11) << scale;
+  }
+}
+
 }  // namespace
 }  // namespace radiosity
