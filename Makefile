@@ -6,6 +6,7 @@ BLENDER    ?= blender
 PYTHON     ?= /usr/bin/python3
 SCENE      ?= office
 CMAKE_ARGS ?=
+MAKEFLAGS  += --no-print-directory
 ifdef CI
 CMAKE_ARGS += -DRADIOSITY_WERROR=ON
 endif
@@ -17,8 +18,9 @@ all: build
 deps:
 	@bash .ci/install-deps.sh
 
+# The module is built for the Python of $(BLENDER), so CMake asks that Blender.
 $(BUILD)/CMakeCache.txt: | deps
-	cmake -S . -B $(BUILD) $(CMAKE_ARGS)
+	cmake -S . -B $(BUILD) -DBLENDER_EXECUTABLE=$(BLENDER) $(CMAKE_ARGS)
 
 configure: $(BUILD)/CMakeCache.txt
 
