@@ -20,7 +20,7 @@ deps:
 
 # The module is built for the Python of $(BLENDER), so CMake asks that Blender.
 $(BUILD)/CMakeCache.txt: | deps
-	cmake -S . -B $(BUILD) -DBLENDER_EXECUTABLE=$(BLENDER) $(CMAKE_ARGS)
+	cmake -S . -B $(BUILD) -DBLENDER_EXECUTABLE="$$(command -v $(BLENDER))" $(CMAKE_ARGS)
 
 configure: $(BUILD)/CMakeCache.txt
 
