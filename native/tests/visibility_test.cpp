@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "core/form_factor.h"
+#include "core/ray_scene.h"
+#include "core/sampled_visibility.h"
 #include "core/visible_polygon.h"
 
 namespace radiosity {
@@ -466,6 +468,90 @@ TEST(VisiblePolygon, ScaleInvariance) {
     EXPECT_NEAR(fg.value, base.value, 1e-13 * base.value) << scale;
     EXPECT_NEAR(glm::length(fg.gradient * scale - base.gradient), 0.0, 1e-11) << scale;
   }
+}
+
+// --- Sampled visibility -------------------------------------------------------------
+
+TEST(SampledVisibility, NoOccluderGivesTheUnoccludedFormFactor) {
+  const dvec3 r(0.03, -0.02, 0.0);
+  const dvec3 n = glm::normalize(dvec3(0.1, -0.2, 1.0));
+  const Polygon emitter = math_emitter();
+  const FormFactorGradient exact = form_factor_gradient(r, n, emitter);
+  const RayScene empty(std::vector<Triangle>{});
+  const FormFactorGradient sampled = sampled_form_factor_gradient(r, n, emitter, empty, {});
+  EXPECT_EQ(sampled.value, exact.value);
+  EXPECT_EQ(sampled.gradient, exact.gradient);
+}
+
+TEST(SampledVisibility, ConvergesToExactAsRaysGrow) {
+  std::mt19937_64 rng(29);
+  const std::vector<int> ray_counts{16, 64, 256, 1024, 4096, 16384};
+  std::vector<double> embree_error(ray_counts.size(), 0.0), own_error(ray_counts.size(), 0.0);
+  const int configurations = 24;
+  for (int i = 0; i < configurations; ++i) {
+    const Configuration c = random_configuration(rng, 1 + i % 4, 0.3);
+    const double exact = visible_f(c.r, c.n, c.emitter, c.occluders);
+    const double unoccluded = form_factor_gradient(c.r, c.n, c.emitter).value;
+    const RayScene scene(c.occluders);
+    for (std::size_t k = 0; k < ray_counts.size(); ++k) {
+      SampledVisibilityOptions options;
+      options.rays = ray_counts[k];
+      options.seed = static_cast<std::uint64_t>(i);
+      const double a = sampled_form_factor_gradient(c.r, c.n, c.emitter, scene, options).value;
+      const double b = sampled_form_factor_gradient(c.r, c.n, c.emitter, c.occluders, options).value;
+      EXPECT_GE(a, 0.0);
+      EXPECT_LE(a, unoccluded);
+      embree_error[k] += std::abs(a - exact) / unoccluded / configurations;
+      own_error[k] += std::abs(b - exact) / unoccluded / configurations;
+    }
+  }
+  for (std::size_t k = 0; k < ray_counts.size(); ++k)
+    std::printf("sampled visibility, %5d rays: mean |F - exact| / F_unoccluded = %.2e (Embree), %.2e (own rays)\n",
+                ray_counts[k], embree_error[k], own_error[k]);
+  // Stratified sampling of a shadow boundary converges like N^-3/4: 256 times
+  // more rays should gain far more than a factor 10.
+  EXPECT_LT(embree_error.back(), 0.1 * embree_error[1]);
+  EXPECT_LT(own_error.back(), 0.1 * own_error[1]);
+  EXPECT_LT(embree_error.back(), 2e-3);
+  EXPECT_LT(own_error.back(), 2e-3);
+}
+
+TEST(SampledVisibility, EmbreeAgreesWithDoublePrecisionRays) {
+  std::mt19937_64 rng(31);
+  int rays = 0, disagreements = 0;
+  for (int i = 0; i < 20; ++i) {
+    const Configuration c = random_configuration(rng, 6, 0.3);
+    const RayScene scene(c.occluders);
+    SampledVisibilityOptions options;
+    options.rays = 1000;
+    const EmitterSamples samples = sample_emitter(c.r, c.n, c.emitter, options);
+    for (const dvec3& y : samples.points) {
+      bool own = false;
+      for (const Triangle& t : c.occluders) own = own || segment_hits_triangle(c.r, y, t);
+      disagreements += own != scene.occluded(c.r, y);
+      ++rays;
+    }
+  }
+  std::printf("Embree vs double-precision shadow rays: %d of %d disagree\n", disagreements, rays);
+  EXPECT_LE(disagreements, rays / 2000);
+}
+
+TEST(SampledVisibility, OwnFacesNeverShadowTheLink) {
+  // A blocker tagged with the receiver's face (or the emitter's) is ignored.
+  const std::vector<Triangle> triangles{
+      Triangle{{dvec3(-5, -5, 1), dvec3(5, -5, 1), dvec3(0, 5, 1)}}};
+  const std::vector<std::uint32_t> face{7};
+  const RayScene scene(triangles, face);
+  const dvec3 from(0.0, 0.0, 0.0), to(0.1, 0.2, 2.0);
+  EXPECT_TRUE(scene.occluded(from, to));
+  EXPECT_FALSE(scene.occluded(from, to, 7));
+  EXPECT_FALSE(scene.occluded(from, to, kNoFace, 7));
+  std::vector<dvec3> targets(20, to);
+  std::vector<std::uint8_t> blocked(20, 0);
+  scene.occluded(from, targets, blocked, 3, 7);
+  for (std::uint8_t b : blocked) EXPECT_EQ(b, 0);
+  scene.occluded(from, targets, blocked);
+  for (std::uint8_t b : blocked) EXPECT_EQ(b, 1);
 }
 
 }  // namespace
