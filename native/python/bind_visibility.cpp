@@ -1,0 +1,104 @@
+// Python access to occluded form factors (Section 4.3): visible_form_factor(),
+// exact (visible polygon, exact gradient) or sampled (shadow rays through Embree).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "core/form_factor.h"
+#include "core/ray_scene.h"
+#include "core/sampled_visibility.h"
+#include "core/triangle.h"
+#include "core/visible_polygon.h"
+#include "python/bindings.h"
+#include "python/numpy_input.h"
+
+namespace py = pybind11;
+
+namespace radiosity::python {
+namespace {
+
+// The visible-polygon code needs a planar, convex emitter (the hierarchy's
+// triangles and quads are): say so here rather than return a wrong number.
+void require_planar_convex(const std::vector<dvec3>& polygon, const std::string& name) {
+  const std::size_t n = polygon.size();
+  dvec3 normal(0.0);
+  double diameter = 0.0;
+  for (std::size_t i = 1; i + 1 < n; ++i)
+    normal += glm::cross(polygon[i] - polygon[0], polygon[i + 1] - polygon[0]);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j)
+      diameter = std::max(diameter, glm::length(polygon[i] - polygon[j]));
+  normal = glm::normalize(normal);
+  for (const dvec3& v : polygon)
+    if (std::abs(glm::dot(normal, v - polygon[0])) > 1e-9 * diameter)
+      throw std::invalid_argument(name + " is not planar");
+  for (std::size_t i = 0; i < n; ++i) {
+    const dvec3& a = polygon[i];
+    const dvec3& b = polygon[(i + 1) % n];
+    const dvec3& c = polygon[(i + 2) % n];
+    if (glm::dot(glm::cross(b - a, c - b), normal) < -1e-12 * diameter * diameter)
+      throw std::invalid_argument(name + " is not convex");
+  }
+}
+
+std::vector<Triangle> read_triangles(const py::handle& object, const std::string& name) {
+  if (object.is_none()) return {};
+  // An empty list or array (any shape with no elements) means no occluders.
+  if (py::isinstance<py::sequence>(object) && !py::isinstance<py::str>(object) &&
+      py::len(object) == 0)
+    return {};
+  const auto a = read_array(object, name, {-1, 3, 3});
+  const auto m = static_cast<std::size_t>(a.shape(0));
+  std::vector<Triangle> triangles(m);
+  const double* p = a.data();
+  for (std::size_t t = 0; t < m; ++t)
+    for (int k = 0; k < 3; ++k)
+      triangles[t].v[k] = {p[9 * t + 3 * k], p[9 * t + 3 * k + 1], p[9 * t + 3 * k + 2]};
+  return triangles;
+}
+
+}  // namespace
+
+void bind_visibility(py::module_& m) {
+  m.def(
+      "visible_form_factor",
+      [](const py::handle& point, const py::handle& normal, const py::handle& emitter,
+         const py::handle& occluders, const std::string& mode, int rays) {
+        const dvec3 r = read_vec3(point, "point");
+        const dvec3 n = read_unit_vec3(normal, "normal");
+        const std::vector<dvec3> polygon = read_polygon(emitter, "emitter");
+        require_planar_convex(polygon, "emitter");
+        const std::vector<Triangle> triangles = read_triangles(occluders, "occluders");
+        if (mode != "exact" && mode != "sampled")
+          throw std::invalid_argument("mode must be 'exact' or 'sampled', got '" + mode + "'");
+        if (rays < 1 || rays > (1 << 24))
+          throw std::invalid_argument("rays must be in [1, 16777216], got " + std::to_string(rays));
+        FormFactorGradient result;
+        {
+          py::gil_scoped_release release;
+          if (mode == "exact") {
+            result = visible_form_factor_gradient(r, n, polygon, triangles);
+          } else {
+            const RayScene scene(triangles);
+            SampledVisibilityOptions options;
+            options.rays = rays;
+            result = sampled_form_factor_gradient(r, n, polygon, scene, options);
+          }
+        }
+        return py::make_tuple(result.value, to_numpy(result.gradient));
+      },
+      py::arg("point"), py::arg("normal"), py::arg("emitter"), py::arg("occluders"),
+      py::arg("mode") = "exact", py::arg("rays") = 64,
+      "(F, grad F) of the part of `emitter` ((n, 3) convex planar polygon,\n"
+      "counter-clockwise about its front normal) visible from `point` past\n"
+      "`occluders` ((m, 3, 3) triangles, m may be 0).\n"
+      "mode='exact': the visible polygon (Section 4.3) and its exact gradient.\n"
+      "mode='sampled': `rays` stratified shadow rays (Embree) give the visible\n"
+      "fraction; F and the unoccluded gradient are scaled by it.");
+}
+
+}  // namespace radiosity::python
