@@ -156,8 +156,8 @@ def run_unittest_file(name, cmd, json_out, timeout, verbose):
 
     if report is None:
         return Outcome(name, failed=1, seconds=seconds,
-                       details="process ended (exit code %s) without writing results:\n%s"
-                               % (code, tail(output)))
+                       details="process ended (exit code %s) without writing results:\n%s%s"
+                               % (code, tail(output), blender_crash_log(output)))
     failed = report["failed"]
     parts = ["%s\n%s" % (f["id"], f["traceback"].rstrip()) for f in report["failures"]]
     if code != 0 and failed == 0:
@@ -169,10 +169,21 @@ def run_unittest_file(name, cmd, json_out, timeout, verbose):
         # The tracebacks above say what failed; the end of the log gives context.
         parts.append("--- end of process output ---\n" + tail(output, LOG_TAIL // 4))
     elif verbose:
-        parts.append(report.get("log", "") + output)
+        parts.append(output)
     passed = report["passed"]
     ran = passed + failed + report["skipped"] > 0
     return Outcome(name, passed, failed, seconds, "\n".join(parts), ran=ran)
+
+
+def blender_crash_log(output):
+    """The backtrace Blender writes when it crashes, if it said where."""
+    match = re.search(r"^Writing: (\S+\.crash\.txt)$", output, re.MULTILINE)
+    if not match:
+        return ""
+    try:
+        return "\n--- %s ---\n%s" % (match.group(1), tail(Path(match.group(1)).read_text(errors="replace"), 40))
+    except OSError:
+        return ""
 
 
 def native_command(args, build, testfile, json_out, patterns):

@@ -15,10 +15,10 @@ to a caller that only checks the code.
 """
 
 import argparse
+import faulthandler
 import fnmatch
 import importlib
 import importlib.util
-import io
 import json
 import os
 import sys
@@ -78,6 +78,13 @@ def load_file(path):
     return module
 
 
+class _ProgressOnly(unittest.TextTestResult):
+    """Prints one line per test; the tracebacks go into the JSON report instead."""
+
+    def printErrors(self):
+        pass
+
+
 class Report:
     def __init__(self, testfile):
         self.data = {"file": testfile, "passed": 0, "failed": 0, "skipped": 0,
@@ -99,6 +106,8 @@ class Report:
 
 def main():
     args = parse_args(sys.argv)
+    # A crash in native code then still shows the Python stack that led to it.
+    faulthandler.enable()
     for path in reversed(args.path):
         sys.path.insert(0, os.path.abspath(path))
     report = Report(args.testfile)
@@ -120,11 +129,12 @@ def main():
             else:
                 suite = unittest.defaultTestLoader.loadTestsFromModule(module)
                 tests = [t for t in iter_tests(suite) if matches(t.id(), args.patterns)]
-                stream = io.StringIO()
-                runner = unittest.TextTestRunner(stream=stream, verbosity=2)
+                # Progress goes to stderr, so that after a crash the caller's
+                # log ends with the test that was running.
+                runner = unittest.TextTestRunner(stream=sys.stderr, verbosity=2,
+                                                 resultclass=_ProgressOnly)
                 result = runner.run(unittest.TestSuite(tests))
                 report.add_result(result, result.testsRun)
-                report.data["log"] = stream.getvalue()
         if addon is not None:
             try:
                 addon.unregister()
