@@ -11,7 +11,7 @@ ifdef CI
 CMAKE_ARGS += -DRADIOSITY_WERROR=ON
 endif
 
-.PHONY: all deps configure build test unit demo scenes package bench clean
+.PHONY: all deps configure build test unit demo scenes package bench figures clean
 
 all: build
 
@@ -43,6 +43,13 @@ package: build
 
 bench: build
 	@$(PYTHON) bench/run_bench.py --build $(BUILD) --blender $(BLENDER) $(if $(QUICK),--quick,)
+
+# Section 4.3.1 of the source (Figures 22-25): F and |grad F| behind an occluder,
+# as PNG images in $(BUILD)/figures (FIGURE_SIZE pixels square).
+FIGURE_SIZE ?= 512
+figures: deps configure
+	@cmake --build $(BUILD) -j $(JOBS) --target visibility_figures
+	@$(BUILD)/tools/visibility_figures $(BUILD)/figures $(FIGURE_SIZE)
 
 clean:
 	rm -rf $(BUILD)
