@@ -37,7 +37,7 @@ def build(scene):
     # No bottom face: it would lie on the floor, unseen and unlit.
     size = 0.5
     kit.add_mesh(scene, "Cube", kit.box((size, size, size), omit=("bottom",)), white,
-                 location=(-0.3, 0.25, size / 2), rotation=(0.0, 0.0, math.radians(20)))
+                 location=(0.3, 0.05, size / 2), rotation=(0.0, 0.0, math.radians(20)))
 
-    kit.add_camera(scene, location=(0.0, -0.95, 1.2), target=(-0.15, 0.4, 0.45), lens=18.0)
+    kit.add_camera(scene, location=(0.0, -0.95, 1.2), target=(0.05, 0.4, 0.4), lens=18.0)
     kit.setup_render(scene)
