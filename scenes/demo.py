@@ -52,7 +52,8 @@ def main():
         sys.exit("error: building scene %r failed:\n%s" % (args.scene, log))
     print("built scene %s (%.1f s)" % (scene_file, time.perf_counter() - start))
 
-    cmd = [args.blender, "--background", str(scene_file), "--python-exit-code", "1",
+    # Factory settings: the user's own preferences and add-ons stay out of the demo.
+    cmd = [args.blender, "--background", "--factory-startup", str(scene_file), "--python-exit-code", "1",
            "--python", str(HERE / "demo_blender.py"), "--",
            "--addon", str(addon), "--oracle", args.oracle, "--samples", str(args.samples),
            "--blend", str(blend), "--png", str(png)]

@@ -1,6 +1,6 @@
 """The Blender side of demo.py: enable the add-on, solve, save, render.
 
-    blender -b SCENE.blend --python demo_blender.py -- --addon BUILD/addon \
+    blender -b --factory-startup SCENE.blend --python demo_blender.py -- --addon BUILD/addon \
         --oracle PERCEPTUAL --samples 32 --blend OUT.blend --png OUT.png
 
 Lines meant for the user start with "[demo] "; demo.py shows only those.
@@ -29,13 +29,14 @@ def parse_args():
 
 
 def enable_addon(path):
-    """Enable the add-on the way Preferences does, from `path` instead of the scripts folder."""
+    """Enable the add-on the way Preferences does, from `path` instead of the
+    scripts folder, without recording it in the preferences."""
     sys.path.insert(0, path)
 
     def fail(err):
         raise err
 
-    addon_utils.enable("radiosity", default_set=True, handle_error=fail)
+    addon_utils.enable("radiosity", default_set=False, handle_error=fail)
 
 
 def solve(scene, oracle):
