@@ -1,4 +1,12 @@
 // Visible polygon of an emitter (Section 4.3): see visible_polygon.h for the method.
+//
+// Implementation notes. Polygons are clipped many times and most intermediate
+// vertices are clipped away again, so a vertex carries only a compact tag while
+// clipping: the two generating lines (indices into a per-call line table) or an
+// anchor (an occluder vertex). Contour vertices (form_factor.h) are made only
+// for the pieces that survive. Pieces live in one flat array with offsets, and
+// all buffers belong to a per-thread workspace, so an evaluation allocates
+// nothing once the workspace has grown.
 #include "core/visible_polygon.h"
 
 #include <algorithm>
@@ -13,8 +21,7 @@ struct EdgeLine {
   // The line lies in the emitter plane (emitter edge, trace of an occluder plane,
   // horizon): it is its own projection, fixed when the receiver moves.
   bool on_emitter_plane = false;
-  // The receiver's horizon: the cosine at the receiver vanishes along it, so
-  // vertices on it act as fixed vertices (MATH.md section 2).
+  // The receiver's horizon (moves with the receiver; MATH.md section 2).
   bool horizon = false;
 };
 
@@ -31,59 +38,86 @@ struct EmitterFrame {
   double height(const dvec3& p) const { return glm::dot(normal, p - origin); }
 };
 
-// A convex polygon on the emitter plane: 2D positions (for clipping), contour
-// vertices (for F and its gradient), and per edge i (vertex i to i+1) its line.
-struct PlanePolygon {
-  std::vector<dvec2> p;
-  std::vector<ContourVertex> v;
-  std::vector<EdgeLine> edge;
-
-  std::size_t size() const { return p.size(); }
-  void clear() {
-    p.clear();
-    v.clear();
-    edge.clear();
-  }
-  void push(const dvec2& q, const ContourVertex& cv, const EdgeLine& out) {
-    p.push_back(q);
-    v.push_back(cv);
-    edge.push_back(out);
-  }
-};
-
-// A half-plane w . q + c >= 0 on the emitter plane, |w| = 1, with the line that
-// generates its boundary.
-struct HalfPlane {
-  dvec2 w{0.0};
-  double c = 0.0;
-  EdgeLine boundary;
-  double distance(const dvec2& q) const { return glm::dot(w, q) + c; }
-};
-
-double cross2(const dvec2& a, const dvec2& b) { return a.x * b.y - a.y * b.x; }
-
-double signed_area(const std::vector<dvec2>& p) {
-  double a = 0.0;
-  for (std::size_t i = 0, k = p.size(); i < k; ++i) a += cross2(p[i], p[(i + 1) % k]);
-  return 0.5 * a;
-}
-
 struct Tolerances {
   double plane = 0.0;  // lengths on the emitter plane (2D clipping)
   double space = 0.0;  // lengths in 3D (occluder clipping, line distances)
   double area = 0.0;   // pieces smaller than this are dropped
 };
 
-// The vertex where edges `a` (incoming) and `b` (outgoing) meet, at `pos` on the
-// emitter plane, seen from `r`.
-ContourVertex crossing_vertex(const EdgeLine& a, const EdgeLine& b, const dvec3& pos,
-                              const dvec3& r, const Tolerances& tol) {
-  // Both lines on the emitter plane (emitter vertex, trace x emitter edge): a
-  // fixed point of the plane.
+// What generates a vertex: an anchor (an occluder vertex, eq. 15), else the
+// crossing of two lines. `edge` is the line of the edge leaving the vertex.
+struct Tag {
+  std::int32_t line_a = -1, line_b = -1;
+  std::int32_t anchor = -1;
+  std::int32_t edge = -1;
+};
+
+struct PlaneVertex {
+  dvec2 p{0.0};
+  Tag tag;
+};
+
+struct SpaceVertex {
+  dvec3 x{0.0};
+  Tag tag;
+};
+
+// A half-plane w . q + c >= 0 on the emitter plane, |w| = 1, bounded by `line`.
+struct HalfPlane {
+  dvec2 w{0.0};
+  double c = 0.0;
+  std::int32_t line = -1;
+  double distance(const dvec2& q) const { return glm::dot(w, q) + c; }
+};
+
+double cross2(const dvec2& a, const dvec2& b) { return a.x * b.y - a.y * b.x; }
+
+double signed_area(std::span<const PlaneVertex> p) {
+  double a = 0.0;
+  for (std::size_t i = 0, k = p.size(); i < k; ++i) a += cross2(p[i].p, p[(i + 1) % k].p);
+  return 0.5 * a;
+}
+
+// Everything one evaluation needs; one per thread, reused.
+struct Workspace {
+  EmitterFrame frame;
+  Tolerances tol;
+  dvec3 r{0.0}, n{0.0};
+  double height_r = 0.0;  // receiver height above the emitter plane
+  double size = 0.0;      // emitter diameter
+  std::vector<EdgeLine> lines;
+  std::vector<dvec3> anchors;
+  std::vector<PlaneVertex> emitter;  // horizon-clipped emitter
+  std::vector<dvec3> corners;        // its corners in 3D
+  std::vector<dvec3> side_normals;   // of the pyramid from r through the emitter
+  // Visible pieces: vertices[start[i], start[i + 1]), double-buffered.
+  std::vector<PlaneVertex> pieces, next_pieces;
+  std::vector<std::uint32_t> start, next_start;
+  // Scratch.
+  std::vector<PlaneVertex> occluder, rest, inside;
+  std::vector<SpaceVertex> space_a, space_b;
+  std::vector<double> dist;
+  std::vector<HalfPlane> halves;
+  std::vector<ContourVertex> contour;
+
+  std::int32_t add_line(const EdgeLine& e) {
+    lines.push_back(e);
+    return static_cast<std::int32_t>(lines.size() - 1);
+  }
+};
+
+// The contour vertex of a tagged vertex at `pos` on the emitter plane.
+ContourVertex resolve(const Tag& tag, const dvec3& pos, const Workspace& w) {
+  if (tag.anchor >= 0) return ContourVertex::intrinsic(pos, w.anchors[tag.anchor]);
+  const EdgeLine& a = w.lines[tag.line_a];
+  const EdgeLine& b = w.lines[tag.line_b];
+  // Both lines on the emitter plane (emitter vertex, trace x emitter edge, an
+  // emitter edge meeting the horizon): a fixed point of the plane (the horizon
+  // case as in form_factor.cpp: its cosine vanishes there, MATH.md section 2).
   if (a.on_emitter_plane && b.on_emitter_plane) return ContourVertex::intrinsic(pos);
   if (a.horizon || b.horizon) {
-    // Where an occluder edge crosses the receiver's horizon: the vertex slides
-    // along the horizon as the edge's plane through r turns (the kernel's horizon
+    // An occluder edge crossing the receiver's horizon: the vertex slides along
+    // the horizon as the edge's plane through r turns (the kernel's horizon
     // vertex, generated by the edge's 3D line `s`).
     ContourVertex v = ContourVertex::intrinsic(pos);
     v.horizon = true;
@@ -97,119 +131,130 @@ ContourVertex crossing_vertex(const EdgeLine& a, const EdgeLine& b, const dvec3&
     // Parallel 3D lines: their projections meet at the vanishing point, whose
     // direction from r does not change as r moves (vertex Jacobian 0, the limit of
     // eq. 15 as the distance grows). A far anchor along the same ray says so.
-    return ContourVertex::intrinsic(pos, r + (pos - r) * 1e9);
+    return ContourVertex::intrinsic(pos, w.r + (pos - w.r) * 1e9);
   }
-  const dvec3 w = b.line.point - a.line.point;
-  const double dist = std::abs(glm::dot(w, c)) / std::sqrt(cc);
-  if (dist <= tol.space) {
-    // The lines meet in 3D: a real vertex (an occluder vertex, a shared mesh vertex,
-    // or an occluder edge piercing the emitter plane), eq. 15 at its 3D position.
-    const double t1 = glm::dot(glm::cross(w, d2), c) / cc;
+  const dvec3 gap = b.line.point - a.line.point;
+  const double dist = std::abs(glm::dot(gap, c)) / std::sqrt(cc);
+  if (dist <= w.tol.space) {
+    // The lines meet in 3D: a real vertex (a shared mesh vertex, an occluder edge
+    // piercing the emitter plane), eq. 15 at its 3D position.
+    const double t1 = glm::dot(glm::cross(gap, d2), c) / cc;
     return ContourVertex::intrinsic(pos, a.line.point + t1 * d1);
   }
   // Two skew lines crossing only as seen from r: an apparent vertex (eq. 14).
   return ContourVertex::apparent_vertex(pos, a.line, b.line);
 }
 
-// Keeps the part of `in` where the half-plane distance has sign `side` (+1 inside,
-// -1 outside), Sutherland-Hodgman with the vertices within `tol.plane` of the
-// line counted on both sides. New edges along the boundary take its line; new
-// vertices are the crossing of the cut edge and the boundary.
-void clip_polygon(const PlanePolygon& in, const std::vector<double>& dist, int side,
-                  const HalfPlane& h, const EmitterFrame& frame, const dvec3& r,
-                  const Tolerances& tol, PlanePolygon& out) {
-  out.clear();
+// Sutherland-Hodgman step shared by the 2D and 3D clips: keeps the vertices
+// whose signed distance has sign `side` (+1 or -1), those within `tol` counting
+// as on the boundary (kept on both sides). New edges along the boundary take its
+// line; new vertices are tagged as the crossing of the cut edge and the boundary.
+template <class Vertex, class Lerp>
+void clip_tagged(std::span<const Vertex> in, std::span<const double> dist, int side, double tol,
+                 std::int32_t boundary, Lerp&& lerp, std::vector<Vertex>& out) {
   const std::size_t k = in.size();
   const auto cls = [&](std::size_t i) {
     const double s = side * dist[i];
-    return s > tol.plane ? 1 : (s < -tol.plane ? -1 : 0);
+    return s > tol ? 1 : (s < -tol ? -1 : 0);
   };
+  int ci = cls(0);
   for (std::size_t i = 0; i < k; ++i) {
-    const std::size_t j = (i + 1) % k;
-    const int ci = cls(i), cj = cls(j);
+    const std::size_t j = i + 1 == k ? 0 : i + 1;
+    const int cj = cls(j);
     if (ci >= 0) {
       if (cj >= 0) {
-        out.push(in.p[i], in.v[i], in.edge[i]);
+        out.push_back(in[i]);
       } else if (ci == 0) {
-        out.push(in.p[i], in.v[i], h.boundary);  // leaves along the boundary
+        out.push_back(in[i]);
+        out.back().tag.edge = boundary;  // leaves along the boundary
       } else {
-        out.push(in.p[i], in.v[i], in.edge[i]);
-        const double t = dist[i] / (dist[i] - dist[j]);
-        const dvec2 q = in.p[i] + t * (in.p[j] - in.p[i]);
-        out.push(q, crossing_vertex(in.edge[i], h.boundary, frame.to_space(q), r, tol),
-                 h.boundary);
+        out.push_back(in[i]);
+        Vertex x = lerp(in[i], in[j], dist[i] / (dist[i] - dist[j]));
+        x.tag = {in[i].tag.edge, boundary, -1, boundary};
+        out.push_back(x);
       }
     } else if (cj > 0) {
-      const double t = dist[i] / (dist[i] - dist[j]);
-      const dvec2 q = in.p[i] + t * (in.p[j] - in.p[i]);
-      out.push(q, crossing_vertex(h.boundary, in.edge[i], frame.to_space(q), r, tol),
-               in.edge[i]);
+      Vertex x = lerp(in[i], in[j], dist[i] / (dist[i] - dist[j]));
+      x.tag = {boundary, in[i].tag.edge, -1, in[i].tag.edge};
+      out.push_back(x);
     }
+    ci = cj;
   }
 }
 
-// Removes consecutive vertices closer than the tolerance (the edge between them
-// has no length; the survivor keeps the later outgoing edge) and reports whether
-// a polygon of positive area is left.
-bool clean_polygon(PlanePolygon& poly, const Tolerances& tol) {
-  if (poly.size() < 3) return false;
-  PlanePolygon out;
-  for (std::size_t i = 0; i < poly.size(); ++i) {
-    if (!out.p.empty() && glm::length(poly.p[i] - out.p.back()) <= tol.plane) {
-      out.edge.back() = poly.edge[i];
+PlaneVertex lerp_plane(const PlaneVertex& a, const PlaneVertex& b, double t) {
+  return {a.p + t * (b.p - a.p), {}};
+}
+SpaceVertex lerp_space(const SpaceVertex& a, const SpaceVertex& b, double t) {
+  return {a.x + t * (b.x - a.x), {}};
+}
+
+// Removes, in place, consecutive vertices of poly[first, end) closer than the
+// tolerance (the survivor keeps the later outgoing edge). Truncates the polygon
+// away and returns false if no positive area is left.
+bool clean_tail(std::vector<PlaneVertex>& poly, std::size_t first, const Tolerances& tol) {
+  std::size_t out = first;
+  for (std::size_t i = first; i < poly.size(); ++i) {
+    if (out > first && glm::length(poly[i].p - poly[out - 1].p) <= tol.plane) {
+      poly[out - 1].tag.edge = poly[i].tag.edge;
       continue;
     }
-    out.push(poly.p[i], poly.v[i], poly.edge[i]);
+    poly[out++] = poly[i];
   }
-  while (out.size() >= 2 && glm::length(out.p.front() - out.p.back()) <= tol.plane) {
-    out.p.pop_back();
-    out.v.pop_back();
-    out.edge.pop_back();
+  while (out - first >= 2 && glm::length(poly[first].p - poly[out - 1].p) <= tol.plane) --out;
+  poly.resize(out);
+  const std::span<const PlaneVertex> p(poly.data() + first, out - first);
+  if (p.size() < 3 || signed_area(p) <= tol.area) {
+    poly.resize(first);
+    return false;
   }
-  if (out.size() < 3 || signed_area(out.p) <= tol.area) return false;
-  poly = std::move(out);
   return true;
 }
 
-// Half-planes bounding a convex counter-clockwise polygon: inside to the left of
-// each edge.
-HalfPlane edge_half_plane(const PlanePolygon& poly, std::size_t i) {
-  const dvec2 a = poly.p[i], b = poly.p[(i + 1) % poly.size()];
+HalfPlane edge_half_plane(std::span<const PlaneVertex> poly, std::size_t i) {
+  const dvec2 a = poly[i].p, b = poly[i + 1 == poly.size() ? 0 : i + 1].p;
   const dvec2 d = glm::normalize(b - a);
   HalfPlane h;
   h.w = {-d.y, d.x};
   h.c = -glm::dot(h.w, a);
-  h.boundary = poly.edge[i];
+  h.line = poly[i].tag.edge;
   return h;
 }
 
-// Separating-axis test for two convex polygons: true when they share no interior.
-bool disjoint(const PlanePolygon& a, const PlanePolygon& b, const Tolerances& tol) {
-  const auto separated_by_edges_of = [&](const PlanePolygon& p, const PlanePolygon& q) {
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      const HalfPlane h = edge_half_plane(p, i);
-      bool all_outside = true;
-      for (const dvec2& x : q.p)
-        if (h.distance(x) > tol.plane) {
-          all_outside = false;
-          break;
-        }
-      if (all_outside) return true;
-    }
-    return false;
-  };
-  return separated_by_edges_of(a, b) || separated_by_edges_of(b, a);
+// Separating-axis test of convex piece `p` against occluder `q` (with its
+// half-planes precomputed): true when they share no interior.
+bool disjoint(std::span<const PlaneVertex> p, std::span<const PlaneVertex> q,
+              std::span<const HalfPlane> q_halves, const Tolerances& tol) {
+  for (const HalfPlane& h : q_halves) {
+    bool all_outside = true;
+    for (const PlaneVertex& x : p)
+      if (h.distance(x.p) > tol.plane) {
+        all_outside = false;
+        break;
+      }
+    if (all_outside) return true;
+  }
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const HalfPlane h = edge_half_plane(p, i);
+    bool all_outside = true;
+    for (const PlaneVertex& x : q)
+      if (h.distance(x.p) > tol.plane) {
+        all_outside = false;
+        break;
+      }
+    if (all_outside) return true;
+  }
+  return false;
 }
 
-// Emitter frame from the polygon (normal from edges relative to v0, MATH.md 1).
 EmitterFrame make_frame(std::span<const dvec3> emitter) {
   EmitterFrame f;
   f.origin = emitter[0];
+  // Normal from edges relative to v0 (MATH.md section 1).
   dvec3 nsum(0.0);
   for (std::size_t i = 1; i + 1 < emitter.size(); ++i)
     nsum += glm::cross(emitter[i] - emitter[0], emitter[i + 1] - emitter[0]);
   f.normal = glm::normalize(nsum);
-  // e1 along the first edge; e2 completes a right-handed frame.
   dvec3 e = emitter[1] - emitter[0];
   e -= glm::dot(e, f.normal) * f.normal;
   f.e1 = glm::normalize(e);
@@ -224,63 +269,25 @@ double diameter(std::span<const dvec3> poly) {
   return d;
 }
 
-// A polygon in 3D during occluder clipping: vertex positions, whether each is an
-// original occluder vertex, and the line of each outgoing edge.
-struct SpacePolygon {
-  std::vector<dvec3> x;
-  std::vector<bool> original;
-  std::vector<EdgeLine> edge;
-  std::size_t size() const { return x.size(); }
-};
-
-// Clips a 3D convex polygon to m . (x - o) >= 0 (points within tol count as in).
-void clip_space(const SpacePolygon& in, const dvec3& m, const dvec3& o, const EdgeLine& boundary,
-                double tol, SpacePolygon& out) {
-  out.x.clear();
-  out.original.clear();
-  out.edge.clear();
-  const std::size_t k = in.size();
-  std::vector<double> d(k);
-  for (std::size_t i = 0; i < k; ++i) d[i] = glm::dot(m, in.x[i] - o);
-  const auto cls = [&](std::size_t i) { return d[i] > tol ? 1 : (d[i] < -tol ? -1 : 0); };
-  const auto push = [&](const dvec3& x, bool orig, const EdgeLine& e) {
-    out.x.push_back(x);
-    out.original.push_back(orig);
-    out.edge.push_back(e);
-  };
-  for (std::size_t i = 0; i < k; ++i) {
-    const std::size_t j = (i + 1) % k;
-    const int ci = cls(i), cj = cls(j);
-    if (ci >= 0) {
-      if (cj >= 0) {
-        push(in.x[i], in.original[i], in.edge[i]);
-      } else if (ci == 0) {
-        push(in.x[i], in.original[i], boundary);
-      } else {
-        push(in.x[i], in.original[i], in.edge[i]);
-        push(in.x[i] + (d[i] / (d[i] - d[j])) * (in.x[j] - in.x[i]), false, boundary);
-      }
-    } else if (cj > 0) {
-      push(in.x[i] + (d[i] / (d[i] - d[j])) * (in.x[j] - in.x[i]), false, in.edge[i]);
-    }
-  }
+// Clips the 3D polygon in w.space_a to m . (x - o) >= 0 (result in w.space_a).
+// Returns false if fewer than 3 vertices remain.
+bool clip_space(Workspace& w, const dvec3& m, const dvec3& o, std::int32_t boundary) {
+  const std::size_t k = w.space_a.size();
+  w.dist.resize(k);
+  for (std::size_t i = 0; i < k; ++i) w.dist[i] = glm::dot(m, w.space_a[i].x - o);
+  w.space_b.clear();
+  clip_tagged<SpaceVertex>(w.space_a, w.dist, +1, w.tol.space, boundary, lerp_space, w.space_b);
+  std::swap(w.space_a, w.space_b);
+  return w.space_a.size() >= 3;
 }
 
-struct Setup {
-  EmitterFrame frame;
-  Tolerances tol;
-  double height_r = 0.0;          // receiver height above the emitter plane
-  double size = 0.0;              // emitter diameter
-  PlanePolygon emitter;            // horizon-clipped emitter, 2D
-  std::vector<dvec3> corners;      // its corners in 3D
-};
-
 // Projects occluder `tri` from r onto the emitter plane, clipped to the pyramid
-// from r through the (horizon-clipped) emitter. Returns false if nothing of
-// positive area remains.
-bool project_occluder(const Triangle& tri, const dvec3& r, const Setup& s, PlanePolygon& q) {
-  const EmitterFrame& f = s.frame;
-  const double tol = s.tol.space;
+// from r through the (horizon-clipped) emitter, into w.occluder (convex,
+// counter-clockwise). Returns false if nothing of positive area remains.
+bool project_occluder(const Triangle& tri, Workspace& w) {
+  const EmitterFrame& f = w.frame;
+  const double tol = w.tol.space;
+  const dvec3& r = w.r;
   // Skip what cannot block: degenerate triangles, triangles whose plane holds r
   // (they project to a segment), triangles on or behind the emitter plane
   // (coplanar faces are the emitter's neighbours, not blockers).
@@ -293,173 +300,223 @@ bool project_occluder(const Triangle& tri, const dvec3& r, const Setup& s, Plane
   for (const dvec3& x : tri.v) hmax = std::max(hmax, f.height(x));
   if (hmax <= tol) return false;
 
-  SpacePolygon poly, tmp;
+  // Quick reject: the whole triangle outside (or on) one side plane of the
+  // pyramid (through r and an emitter edge, normal pointing inwards).
+  const std::size_t k = w.corners.size();
+  std::vector<dvec3>& side_normal = w.side_normals;
+  side_normal.resize(k);
+  for (std::size_t i = 0; i < k; ++i) {
+    const dvec3 vi = w.corners[i], vj = w.corners[(i + 1) % k];
+    const dvec3 m = glm::cross(r - vi, vj - vi);
+    const double ml = glm::length(m);
+    side_normal[i] = ml > 0.0 ? m / ml : dvec3(0.0);
+    if (!(ml > 0.0)) continue;
+    if (glm::dot(side_normal[i], tri.v[0] - r) <= tol && glm::dot(side_normal[i], tri.v[1] - r) <= tol &&
+        glm::dot(side_normal[i], tri.v[2] - r) <= tol)
+      return false;
+  }
+
+  const auto first_line = static_cast<std::int32_t>(w.lines.size());
+  const auto first_anchor = static_cast<std::int32_t>(w.anchors.size());
+  w.space_a.clear();
   for (int i = 0; i < 3; ++i) {
     const dvec3 a = tri.v[i], b = tri.v[(i + 1) % 3];
     const bool planar = std::abs(f.height(a)) <= tol && std::abs(f.height(b)) <= tol;
-    poly.x.push_back(a);
-    poly.original.push_back(true);
-    poly.edge.push_back({Line{a, b - a}, planar, false});
+    w.add_line({Line{a, b - a}, planar, false});
+    w.anchors.push_back(a);
+    w.space_a.push_back({a, Tag{-1, -1, first_anchor + i, first_line + i}});
   }
-
-  // Side planes of the pyramid: through r and each edge of the emitter, normal
-  // pointing inwards ((r - v_i) x e_i, vertices counter-clockwise about the front).
-  const std::size_t k = s.corners.size();
   for (std::size_t i = 0; i < k; ++i) {
-    const dvec3 vi = s.corners[i], vj = s.corners[(i + 1) % k];
-    dvec3 m = glm::cross(r - vi, vj - vi);
-    const double ml = glm::length(m);
-    if (!(ml > 0.0)) continue;
-    m /= ml;
-    // Quick reject: the whole triangle outside (or on) this side plane.
-    bool all_out = true;
-    for (const dvec3& x : tri.v)
-      if (glm::dot(m, x - r) > tol) {
-        all_out = false;
-        break;
-      }
-    if (all_out) return false;
-    clip_space(poly, m, r, s.emitter.edge[i], tol, tmp);
-    std::swap(poly, tmp);
-    if (poly.size() < 3) return false;
+    if (side_normal[i] == dvec3(0.0)) continue;
+    if (!clip_space(w, side_normal[i], r, w.emitter[i].tag.edge)) return false;
   }
   // Emitter plane: keep the part in front of it. The new edge is the trace of the
   // occluder's plane on the emitter plane.
   double hmin = 1e300;
-  for (const dvec3& x : poly.x) hmin = std::min(hmin, f.height(x));
+  for (const SpaceVertex& v : w.space_a) hmin = std::min(hmin, f.height(v.x));
   if (hmin < -tol) {
-    const dvec3 dir = glm::cross(nt_unit, f.normal);
-    const double dd = glm::dot(dir, dir);
     EdgeLine trace;
     trace.on_emitter_plane = true;
-    trace.line.direction = dir;
+    trace.line.direction = glm::cross(nt_unit, f.normal);
+    const double dd = glm::dot(trace.line.direction, trace.line.direction);
     if (dd > 1e-24) {
       const double h1 = glm::dot(nt_unit, tri.v[0]), h2 = glm::dot(f.normal, f.origin);
-      trace.line.point = (h1 * glm::cross(f.normal, dir) + h2 * glm::cross(dir, nt_unit)) / dd;
+      trace.line.point = (h1 * glm::cross(f.normal, trace.line.direction) +
+                          h2 * glm::cross(trace.line.direction, nt_unit)) / dd;
     } else {
       trace.line.point = f.origin;
     }
-    clip_space(poly, f.normal, f.origin, trace, tol, tmp);
-    std::swap(poly, tmp);
-    if (poly.size() < 3) return false;
+    if (!clip_space(w, f.normal, f.origin, w.add_line(trace))) return false;
   }
 
   // Central projection from r onto the emitter plane.
-  const std::size_t m = poly.size();
-  q.clear();
+  const std::size_t m = w.space_a.size();
+  w.occluder.clear();
   for (std::size_t i = 0; i < m; ++i) {
-    const dvec3& x = poly.x[i];
-    const double depth = s.height_r - f.height(x);  // > 0 between r and the emitter
+    const dvec3& x = w.space_a[i].x;
+    const double depth = w.height_r - f.height(x);  // > 0 between r and the emitter
     if (!(depth > 0.0)) return false;                // only at r itself: plane through r
-    const dvec3 pos = r + (x - r) * (s.height_r / depth);
-    q.p.push_back(f.to_plane(pos));
-    q.edge.push_back(poly.edge[i]);
-    const EdgeLine& incoming = poly.edge[(i + m - 1) % m];
-    q.v.push_back(poly.original[i] ? ContourVertex::intrinsic(f.to_space(q.p.back()), x)
-                                   : crossing_vertex(incoming, poly.edge[i],
-                                                     f.to_space(q.p.back()), r, s.tol));
+    w.occluder.push_back({f.to_plane(r + (x - r) * (w.height_r / depth)), w.space_a[i].tag});
   }
-  // Counter-clockwise, like the pieces it is subtracted from.
-  if (signed_area(q.p) < 0.0) {
-    PlanePolygon rev;
-    for (std::size_t i = 0; i < m; ++i) {
-      const std::size_t a = m - 1 - i;              // vertex
-      const std::size_t e = (2 * m - 2 - i) % m;    // edge from old a to old a-1
-      rev.push(q.p[a], q.v[a], q.edge[e]);
-    }
-    q = std::move(rev);
+  // Counter-clockwise, like the pieces it is subtracted from: reverse the
+  // vertices, each then leaving along the edge that used to reach it.
+  if (signed_area(w.occluder) < 0.0) {
+    std::reverse(w.occluder.begin(), w.occluder.end());
+    const std::int32_t first_edge = w.occluder[0].tag.edge;
+    for (std::size_t i = 0; i + 1 < m; ++i) w.occluder[i].tag.edge = w.occluder[i + 1].tag.edge;
+    w.occluder[m - 1].tag.edge = first_edge;
   }
-  return clean_polygon(q, s.tol);
+  return clean_tail(w.occluder, 0, w.tol);
 }
 
-// Subtracts convex `q` from every piece (successive half-planes, DESIGN.md 4).
-void subtract(std::vector<PlanePolygon>& pieces, const PlanePolygon& q, const dvec3& r,
-              const Setup& s, std::vector<PlanePolygon>& scratch) {
-  scratch.clear();
-  std::vector<HalfPlane> halves(q.size());
-  for (std::size_t i = 0; i < q.size(); ++i) halves[i] = edge_half_plane(q, i);
-  std::vector<double> dist;
-  PlanePolygon inside, outside;
-  for (PlanePolygon& piece : pieces) {
-    if (disjoint(piece, q, s.tol)) {
-      scratch.push_back(std::move(piece));
+// Subtracts the convex w.occluder from every piece (successive half-planes,
+// DESIGN.md 4): the parts of a piece outside each edge in turn are kept, what
+// is left inside all edges is hidden.
+void subtract_occluder(Workspace& w) {
+  const std::span<const PlaneVertex> q(w.occluder);
+  w.halves.resize(q.size());
+  for (std::size_t i = 0; i < q.size(); ++i) w.halves[i] = edge_half_plane(q, i);
+  w.next_pieces.clear();
+  w.next_start.assign(1, 0);
+  const auto close_piece = [&] { w.next_start.push_back(static_cast<std::uint32_t>(w.next_pieces.size())); };
+  for (std::size_t piece = 0; piece + 1 < w.start.size(); ++piece) {
+    const std::span<const PlaneVertex> p(w.pieces.data() + w.start[piece], w.start[piece + 1] - w.start[piece]);
+    if (disjoint(p, q, w.halves, w.tol)) {
+      w.next_pieces.insert(w.next_pieces.end(), p.begin(), p.end());
+      close_piece();
       continue;
     }
-    PlanePolygon rest = std::move(piece);
-    for (const HalfPlane& h : halves) {
-      dist.resize(rest.size());
+    w.rest.assign(p.begin(), p.end());
+    for (const HalfPlane& h : w.halves) {
+      w.dist.resize(w.rest.size());
       bool any_out = false;
-      for (std::size_t i = 0; i < rest.size(); ++i) {
-        dist[i] = h.distance(rest.p[i]);
-        any_out = any_out || dist[i] < -s.tol.plane;
+      for (std::size_t i = 0; i < w.rest.size(); ++i) {
+        w.dist[i] = h.distance(w.rest[i].p);
+        any_out = any_out || w.dist[i] < -w.tol.plane;
       }
       if (!any_out) continue;  // the rest lies inside this half-plane: no cut
-      clip_polygon(rest, dist, -1, h, s.frame, r, s.tol, outside);
-      if (clean_polygon(outside, s.tol)) scratch.push_back(outside);
-      clip_polygon(rest, dist, +1, h, s.frame, r, s.tol, inside);
-      if (!clean_polygon(inside, s.tol)) {
-        rest.clear();
+      const std::size_t first = w.next_pieces.size();
+      clip_tagged<PlaneVertex>(w.rest, w.dist, -1, w.tol.plane, h.line, lerp_plane, w.next_pieces);
+      if (clean_tail(w.next_pieces, first, w.tol)) close_piece();
+      w.inside.clear();
+      clip_tagged<PlaneVertex>(w.rest, w.dist, +1, w.tol.plane, h.line, lerp_plane, w.inside);
+      if (!clean_tail(w.inside, 0, w.tol)) {
+        w.rest.clear();
         break;
       }
-      rest = inside;
+      std::swap(w.rest, w.inside);
     }
-    // What is left of the piece lies inside q: hidden.
+    // What is left of the piece lies inside the occluder: hidden.
   }
-  std::swap(pieces, scratch);
+  std::swap(w.pieces, w.next_pieces);
+  std::swap(w.start, w.next_start);
 }
 
-// Builds the frame and tolerances and clips the emitter to the horizon. Returns
-// false when the receiver cannot see the emitter's front at all.
-bool make_setup(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter, Setup& s) {
-  s.frame = make_frame(emitter);
-  const double size = diameter(emitter);
-  s.size = size;
-  s.height_r = s.frame.height(r);
-  // Receiver on or behind the emitter plane sees nothing (MATH.md section 3).
-  // (same threshold as form_factor.cpp, so the two agree on what is visible).
-  const double rounding = 1e-15 * (glm::length(r) + glm::length(s.frame.origin));
-  if (!(s.height_r > 1e-12 * size + rounding)) return false;
-  s.tol.plane = 1e-11 * size;
-  s.tol.space = 1e-11 * std::max(size, glm::length(r - s.frame.origin));
-  s.tol.area = 1e-22 * size * size;
+// Frame, tolerances, line table and the horizon-clipped emitter. Returns false
+// when the receiver cannot see the emitter's front at all.
+bool setup(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter, Workspace& w) {
+  w.r = r;
+  w.n = n;
+  w.frame = make_frame(emitter);
+  w.size = diameter(emitter);
+  w.height_r = w.frame.height(r);
+  // Receiver on or behind the emitter plane sees nothing (MATH.md section 3),
+  // with the threshold of form_factor.cpp so the two agree on what is visible.
+  const double rounding = 1e-15 * (glm::length(r) + glm::length(w.frame.origin));
+  if (!(w.height_r > 1e-12 * w.size + rounding)) return false;
+  w.tol.plane = 1e-11 * w.size;
+  w.tol.space = 1e-11 * std::max(w.size, glm::length(r - w.frame.origin));
+  w.tol.area = 1e-22 * w.size * w.size;
+  w.lines.clear();
+  w.anchors.clear();
 
-  PlanePolygon poly;
   const std::size_t k = emitter.size();
+  w.emitter.clear();
   for (std::size_t i = 0; i < k; ++i) {
     const dvec3 a = emitter[i], b = emitter[(i + 1) % k];
-    poly.push(s.frame.to_plane(a), ContourVertex::intrinsic(a), {Line{a, b - a}, true, false});
+    const std::int32_t line = w.add_line({Line{a, b - a}, true, false});
+    const auto previous = static_cast<std::int32_t>(i == 0 ? k - 1 : i - 1);
+    w.emitter.push_back({w.frame.to_plane(a), Tag{previous, line, -1, line}});
   }
-  // Horizon: n . (x - r) >= 0 on the emitter plane is w . q + c >= 0.
+  w.emitter[0].tag.line_a = static_cast<std::int32_t>(k - 1);
+  // Horizon: n . (x - r) >= 0 on the emitter plane is h.w . q + h.c >= 0.
   HalfPlane h;
-  h.w = {glm::dot(n, s.frame.e1), glm::dot(n, s.frame.e2)};
-  h.c = glm::dot(n, s.frame.origin - r);
+  h.w = {glm::dot(n, w.frame.e1), glm::dot(n, w.frame.e2)};
+  h.c = glm::dot(n, w.frame.origin - r);
   const double wl = glm::length(h.w);
   if (wl > 1e-12) {
     h.w /= wl;
     h.c /= wl;
-    h.boundary.on_emitter_plane = true;
-    h.boundary.horizon = true;
-    h.boundary.line.direction = s.frame.to_space(dvec2(-h.w.y, h.w.x)) - s.frame.origin;
-    h.boundary.line.point = s.frame.to_space(-h.c * h.w);
-    std::vector<double> dist(poly.size());
+    EdgeLine horizon;
+    horizon.on_emitter_plane = true;
+    horizon.horizon = true;
+    horizon.line.direction = w.frame.to_space(dvec2(-h.w.y, h.w.x)) - w.frame.origin;
+    horizon.line.point = w.frame.to_space(-h.c * h.w);
+    h.line = w.add_line(horizon);
+    w.dist.resize(k);
     bool any_below = false;
-    for (std::size_t i = 0; i < poly.size(); ++i) {
-      dist[i] = h.distance(poly.p[i]);
-      any_below = any_below || dist[i] < -s.tol.plane;
+    for (std::size_t i = 0; i < k; ++i) {
+      w.dist[i] = h.distance(w.emitter[i].p);
+      any_below = any_below || w.dist[i] < -w.tol.plane;
     }
     if (any_below) {
-      PlanePolygon clipped;
-      clip_polygon(poly, dist, +1, h, s.frame, r, s.tol, clipped);
-      poly = std::move(clipped);
+      w.inside.clear();
+      clip_tagged<PlaneVertex>(w.emitter, w.dist, +1, w.tol.plane, h.line, lerp_plane, w.inside);
+      std::swap(w.emitter, w.inside);
     }
   } else if (h.c <= 0.0) {
     return false;  // receiver plane parallel to the emitter, facing away
   }
-  if (!clean_polygon(poly, s.tol)) return false;
-  s.emitter = poly;
-  s.corners.clear();
-  for (const dvec2& q : s.emitter.p) s.corners.push_back(s.frame.to_space(q));
+  if (!clean_tail(w.emitter, 0, w.tol)) return false;
+  w.corners.clear();
+  for (const PlaneVertex& v : w.emitter) w.corners.push_back(w.frame.to_space(v.p));
   return true;
+}
+
+// Runs the whole method; the visible pieces are left in w.pieces / w.start.
+// Returns false if nothing is visible, sets `occluded` if an occluder mattered.
+bool compute_visible_pieces(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter,
+                            std::span<const Triangle> occluders, Workspace& w, bool& occluded) {
+  occluded = false;
+  if (emitter.size() < 3 || !setup(r, n, emitter, w)) return false;
+  w.pieces.assign(w.emitter.begin(), w.emitter.end());
+  w.start.assign({0u, static_cast<std::uint32_t>(w.emitter.size())});
+  for (const Triangle& tri : occluders) {
+    const std::size_t lines = w.lines.size(), anchors = w.anchors.size();
+    if (!project_occluder(tri, w)) {
+      // Nothing of it is in the way: forget its lines.
+      w.lines.resize(lines);
+      w.anchors.resize(anchors);
+      continue;
+    }
+    occluded = true;
+    subtract_occluder(w);
+    if (w.start.size() <= 1) return false;  // all hidden
+  }
+  return true;
+}
+
+// The contour of piece i, as the kernel wants it, in w.contour. Vertices on the
+// horizon can land a rounding error below it; the kernel would clip them again
+// and make slivers, so they are lifted onto the upper side, within the emitter
+// plane (a shift of about 1e-15 of the scene's size).
+std::span<const ContourVertex> piece_contour(Workspace& w, std::size_t i) {
+  const dvec3 n_plane = w.n - glm::dot(w.n, w.frame.normal) * w.frame.normal;
+  const double n_plane2 = glm::dot(n_plane, n_plane);
+  const double lift = 4e-16 * (glm::length(w.r) + glm::length(w.frame.origin) + w.size);
+  w.contour.clear();
+  for (std::uint32_t k = w.start[i]; k < w.start[i + 1]; ++k) {
+    dvec3 pos = w.frame.to_space(w.pieces[k].p);
+    const double h = glm::dot(w.n, pos - w.r);
+    if (h < 0.0 && n_plane2 > 0.0) pos += ((lift - h) / n_plane2) * n_plane;
+    w.contour.push_back(resolve(w.pieces[k].tag, pos, w));
+  }
+  return w.contour;
+}
+
+Workspace& thread_workspace() {
+  thread_local Workspace w;
+  return w;
 }
 
 }  // namespace
@@ -467,29 +524,12 @@ bool make_setup(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter, 
 VisiblePolygon visible_polygon(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter,
                                std::span<const Triangle> occluders) {
   VisiblePolygon out;
-  Setup s;
-  if (emitter.size() < 3 || !make_setup(r, n, emitter, s)) return out;
-  std::vector<PlanePolygon> pieces{s.emitter}, scratch;
-  PlanePolygon q;
-  for (const Triangle& tri : occluders) {
-    if (!project_occluder(tri, r, s, q)) continue;
-    out.occluded = true;
-    subtract(pieces, q, r, s, scratch);
-    if (pieces.empty()) break;
-  }
-  // Vertices on the horizon can land a rounding error below it; the kernel would
-  // clip them again and make slivers. Lift them onto the upper side, within the
-  // emitter plane (a shift of about 1e-15 of the scene's size).
-  const dvec3 n_plane = n - glm::dot(n, s.frame.normal) * s.frame.normal;
-  const double n_plane2 = glm::dot(n_plane, n_plane);
-  const double lift = 4e-16 * (glm::length(r) + glm::length(s.frame.origin) + s.size);
-  out.pieces.reserve(pieces.size());
-  for (PlanePolygon& p : pieces) {
-    for (ContourVertex& v : p.v) {
-      const double h = glm::dot(n, v.position - r);
-      if (h < 0.0 && n_plane2 > 0.0) v.position += ((lift - h) / n_plane2) * n_plane;
-    }
-    out.pieces.push_back(std::move(p.v));
+  Workspace& w = thread_workspace();
+  if (!compute_visible_pieces(r, n, emitter, occluders, w, out.occluded)) return out;
+  out.pieces.reserve(w.start.size() - 1);
+  for (std::size_t i = 0; i + 1 < w.start.size(); ++i) {
+    const std::span<const ContourVertex> c = piece_contour(w, i);
+    out.pieces.emplace_back(c.begin(), c.end());
   }
   return out;
 }
@@ -497,20 +537,21 @@ VisiblePolygon visible_polygon(const dvec3& r, const dvec3& n, std::span<const d
 FormFactorGradient visible_form_factor_gradient(const dvec3& r, const dvec3& n,
                                                 std::span<const dvec3> emitter,
                                                 std::span<const Triangle> occluders) {
-  const VisiblePolygon visible = visible_polygon(r, n, emitter, occluders);
-  if (visible.empty()) return {};
+  Workspace& w = thread_workspace();
+  bool occluded = false;
+  if (!compute_visible_pieces(r, n, emitter, occluders, w, occluded)) return {};
   const FormFactorGradient unoccluded = form_factor_gradient(r, n, emitter);
-  if (!visible.occluded) return unoccluded;
+  if (!occluded) return unoccluded;
   FormFactorGradient sum;
-  for (const VisiblePiece& piece : visible.pieces) {
-    const FormFactorGradient fg = form_factor_gradient(r, n, std::span<const ContourVertex>(piece));
+  for (std::size_t i = 0; i + 1 < w.start.size(); ++i) {
+    const FormFactorGradient fg = form_factor_gradient(r, n, piece_contour(w, i));
     sum.value += fg.value;
     sum.gradient += fg.gradient;
   }
-  // Rounding can push the sum a hair outside [0, unoccluded F]; the pieces are a
-  // subset of the emitter, so clamp there.
-  // A non-finite sum would mean a vertex Jacobian blew up at an exact D1 event
-  // (eq. 14 singular); the gradient is undefined there, F is not.
+  // A non-finite gradient would mean a vertex Jacobian blew up at an exact D1
+  // event (eq. 14 singular); the gradient is undefined there, F is not. Rounding
+  // can push the sum a hair outside [0, unoccluded F]; the pieces are a subset of
+  // the emitter, so clamp there.
   if (!std::isfinite(sum.gradient.x) || !std::isfinite(sum.gradient.y) ||
       !std::isfinite(sum.gradient.z))
     sum.gradient = dvec3(0.0);
