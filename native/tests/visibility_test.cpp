@@ -437,6 +437,94 @@ TEST(VisiblePolygon, DegenerateConfigurations) {
   EXPECT_EQ(visible_f(dvec3(0.1, 0.1, 3.0), n, emitter, {math_occluder()}), 0.0);
 }
 
+// Random configurations built to hit the degenerate cases at once: occluder
+// vertices snapped onto emitter vertices, emitter edges, the emitter plane, the
+// rays from r through emitter vertices and the planes through r and emitter
+// edges (exact D1/D2 events), at r itself; edges parallel to emitter edges;
+// duplicated and edge-sharing triangles; slivers, tiny and huge triangles.
+TEST(VisiblePolygon, DegenerateFuzz) {
+  std::mt19937_64 rng(37);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  int checked = 0, against_monte_carlo = 0, occluded = 0;
+  double worst_sigmas = 0.0, largest_gradient = 0.0;
+  for (int i = 0; i < 400; ++i) {
+    Configuration c = random_configuration(rng, 0, 0.0);
+    const std::size_t k = c.emitter.size();
+    const dvec3 centre = (c.emitter[0] + c.emitter[k / 2]) * 0.5;
+    const auto special_point = [&]() -> dvec3 {
+      const std::size_t e = rng() % k;
+      const dvec3 a = c.emitter[e], b = c.emitter[(e + 1) % k];
+      const double t = uni(rng);
+      switch (rng() % 8) {
+        case 0: return a;                                              // emitter vertex
+        case 1: return a + t * (b - a);                                // on an emitter edge
+        case 2: return c.r + (0.2 + 0.6 * t) * (a - c.r);              // on the ray to a vertex
+        case 3: return c.r + (0.2 + 0.6 * t) * (a + uni(rng) * (b - a) - c.r);  // plane r, edge
+        case 4: return c.r;                                            // at the receiver
+        case 5: return centre + (uni(rng) - 0.5) * (b - a) + (uni(rng) - 0.5) * (a - centre);
+        default: return c.r + (0.1 + 0.8 * t) * (centre - c.r) + random_in_ball(rng, 0.4);
+      }
+    };
+    const int count = 1 + static_cast<int>(rng() % 6);
+    for (int j = 0; j < count; ++j) {
+      Triangle t;
+      switch (rng() % 5) {
+        case 0:  // three special points
+          for (dvec3& v : t.v) v = special_point();
+          break;
+        case 1: {  // parallel to the emitter plane, one edge parallel to an emitter edge
+          const std::size_t e = rng() % k;
+          const dvec3 along = c.emitter[(e + 1) % k] - c.emitter[e];
+          const double f = 0.2 + 0.6 * uni(rng);
+          const dvec3 base = c.r + f * (centre - c.r);
+          const dvec3 normal = glm::normalize(glm::cross(c.emitter[1] - c.emitter[0], c.emitter[2] - c.emitter[0]));
+          t.v = {base, base + 0.5 * along, base + 0.4 * glm::cross(normal, along) + 0.1 * along};
+          break;
+        }
+        case 2:  // sliver
+          t.v[0] = special_point();
+          t.v[1] = special_point();
+          t.v[2] = t.v[0] + (t.v[1] - t.v[0]) * 0.5 + random_in_ball(rng, 1e-9);
+          break;
+        case 3:  // tiny or huge around a special point
+          t.v[0] = special_point();
+          t.v[1] = t.v[0] + random_in_ball(rng, uni(rng) < 0.5 ? 1e-8 : 5.0);
+          t.v[2] = t.v[0] + random_in_ball(rng, uni(rng) < 0.5 ? 1e-8 : 5.0);
+          break;
+        default:  // shares an edge with the previous one, or duplicates it
+          if (!c.occluders.empty()) {
+            t = c.occluders.back();
+            if (rng() % 2) t.v[2] = special_point();
+          } else {
+            for (dvec3& v : t.v) v = special_point();
+          }
+      }
+      c.occluders.push_back(t);
+    }
+    const FormFactorGradient fg = visible_form_factor_gradient(c.r, c.n, c.emitter, c.occluders);
+    const double unoccluded = form_factor_gradient(c.r, c.n, c.emitter).value;
+    ++checked;
+    occluded += fg.value < unoccluded;
+    ASSERT_TRUE(std::isfinite(fg.value) && std::isfinite(glm::length(fg.gradient))) << "case " << i;
+    EXPECT_GE(fg.value, 0.0) << "case " << i;
+    EXPECT_LE(fg.value, unoccluded) << "case " << i;
+    largest_gradient = std::max(largest_gradient, glm::length(fg.gradient));
+    EXPECT_LT(glm::length(fg.gradient), 1e4) << "case " << i;
+    if (i % 8 == 0) {
+      const MonteCarlo mc = monte_carlo_form_factor(c.r, c.n, c.emitter, c.occluders, 100000, rng);
+      const double sigmas = std::abs(fg.value - mc.mean) / (mc.standard_error + 1e-300);
+      worst_sigmas = std::max(worst_sigmas, std::abs(fg.value - mc.mean) > 1e-12 ? sigmas : 0.0);
+      EXPECT_LT(std::abs(fg.value - mc.mean), 4.5 * mc.standard_error + 1e-12)
+          << "case " << i << ": exact " << fg.value << " mc " << mc.mean << " +- " << mc.standard_error;
+      ++against_monte_carlo;
+    }
+  }
+  std::printf("degenerate fuzz: %d configurations (%d occluded), %d against Monte Carlo (worst "
+              "%.2f sigma), largest |grad F| %.3g\n", checked, occluded, against_monte_carlo,
+              worst_sigmas, largest_gradient);
+  EXPECT_GT(occluded, checked / 2);
+}
+
 TEST(VisiblePolygon, ManyOverlappingOccluders) {
   std::mt19937_64 rng(19);
   for (int i = 0; i < 4; ++i) {
