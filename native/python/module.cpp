@@ -13,4 +13,5 @@ PYBIND11_MODULE(_radiosity, m) {
   m.attr("__version__") = RADIOSITY_VERSION;
   radiosity::python::bind_kernels(m);
   radiosity::python::bind_visibility(m);
+  radiosity::python::bind_solver(m);
 }

@@ -1,0 +1,124 @@
+#include "core/link_transport.h"
+
+#include <chrono>
+#include <vector>
+
+#include "core/form_factor.h"
+#include "core/sampled_visibility.h"
+#include "core/visible_polygon.h"
+
+namespace radiosity {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Some corner of `polygon` lies strictly in front of the plane (point, normal),
+// by more than rounding relative to the sizes involved.
+bool any_in_front(const dvec3* polygon, int count, const dvec3& point, const dvec3& normal,
+                  double tolerance) {
+  for (int k = 0; k < count; ++k) {
+    if (glm::dot(normal, polygon[k] - point) > tolerance) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+SceneOccluders make_scene_occluders(const Scene& scene, VisibilityMode mode) {
+  std::vector<Triangle> triangles;
+  std::vector<std::uint32_t> face;
+  for (const Patch& p : scene.patches) {
+    triangles.push_back({{p.corners[0], p.corners[1], p.corners[2]}});
+    face.push_back(p.face);
+    if (p.corner_count == 4) {
+      triangles.push_back({{p.corners[0], p.corners[2], p.corners[3]}});
+      face.push_back(p.face);
+    }
+  }
+  SceneOccluders occluders;
+  if (mode == VisibilityMode::Sampled) occluders.rays = std::make_unique<RayScene>(triangles, face);
+  occluders.shafts = make_occluder_scene(std::move(triangles), std::move(face));
+  return occluders;
+}
+
+bool elements_face_each_other(const Hierarchy& h, const Element& receiver, const Element& emitter) {
+  dvec3 p[4], q[4];
+  const int np = h.corners(receiver, p), nq = h.corners(emitter, q);
+  const double tolerance = 1e-9 * (h.diameter(receiver) + h.diameter(emitter));
+  return any_in_front(q, nq, p[0], h.normal(receiver), tolerance) &&
+         any_in_front(p, np, q[0], h.normal(emitter), tolerance);
+}
+
+bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings) const {
+  const Element& receiver = hierarchy.element(link.receiver);
+  const Element& emitter = hierarchy.element(link.emitter);
+  link.form_factor.fill(0.0f);
+  link.oracle = 0.0f;
+  if (!elements_face_each_other(hierarchy, receiver, emitter)) return false;
+
+  dvec3 receiver_corners[4], emitter_corners[4], x[kMaxSamples];
+  const int nr = hierarchy.corners(receiver, receiver_corners);
+  const int ne = hierarchy.corners(emitter, emitter_corners);
+  const int ns = hierarchy.samples(receiver, x);
+  const std::span<const dvec3> emitter_polygon(emitter_corners, static_cast<size_t>(ne));
+  const dvec3 n = hierarchy.normal(receiver);
+
+  auto start = Clock::now();
+  const ShaftCulling culling = cull_shaft(
+      occluders.shafts, std::span<const dvec3>(receiver_corners, static_cast<size_t>(nr)),
+      hierarchy.patch_of(receiver).face, emitter_polygon, hierarchy.patch_of(emitter).face);
+  timings.visibility += seconds_since(start);
+  if (culling.visibility == ShaftVisibility::hidden) return false;
+
+  start = Clock::now();
+  thread_local std::vector<Triangle> candidates;
+  candidates.clear();
+  for (std::uint32_t t : culling.candidates) candidates.push_back(occluders.shafts.triangles[t]);
+  const bool gradient = oracle_needs_gradient(oracle);
+  double value[kMaxSamples];
+  dvec3 grad[kMaxSamples];
+  bool any = false;
+  for (int s = 0; s < ns; ++s) {
+    FormFactorGradient f;
+    if (culling.visibility == ShaftVisibility::clear) {
+      f = gradient ? form_factor_gradient(x[s], n, emitter_polygon)
+                   : FormFactorGradient{form_factor(x[s], n, emitter_polygon), dvec3(0.0)};
+    } else if (visibility == VisibilityMode::Exact) {
+      f = visible_form_factor_gradient(x[s], n, emitter_polygon, candidates);
+    } else {
+      // Rays per sample vary their seed with the sample, so neighbours do not
+      // share the same stratification pattern.
+      // Few candidates: test them directly in double precision; many: let
+      // Embree traverse the scene.
+      const SampledVisibilityOptions options{rays, static_cast<std::uint64_t>(s)};
+      f = candidates.size() > 64 && occluders.rays
+              ? sampled_form_factor_gradient(x[s], n, emitter_polygon, *occluders.rays, options,
+                                             hierarchy.patch_of(receiver).face,
+                                             hierarchy.patch_of(emitter).face)
+              : sampled_form_factor_gradient(x[s], n, emitter_polygon, candidates, options);
+    }
+    value[s] = std::max(0.0, f.value);
+    grad[s] = f.gradient;
+    link.form_factor[static_cast<size_t>(s)] = static_cast<float>(value[s]);
+    any |= value[s] > 0.0;
+  }
+  timings.form_factors += seconds_since(start);
+  if (!any) return false;
+
+  start = Clock::now();
+  LinkSamples samples{std::span<const dvec3>(x, static_cast<size_t>(ns)),
+                      std::span<const double>(value, static_cast<size_t>(ns)),
+                      std::span<const dvec3>(grad, static_cast<size_t>(ns)),
+                      n,
+                      static_cast<double>(receiver.area),
+                      hierarchy.diameter(receiver)};
+  link.oracle = static_cast<float>(oracle_geometry(oracle, samples));
+  timings.oracle += seconds_since(start);
+  return true;
+}
+
+}  // namespace radiosity

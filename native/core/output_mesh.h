@@ -1,0 +1,33 @@
+// The solution as a mesh (DESIGN s5): the leaves of every lit patch side as
+// polygons over shared vertices, with the hanging vertices of finer neighbours
+// inserted into coarser polygons so Gouraud shading shows no cracks, and the
+// radiance L_e + rho H at every vertex.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/color.h"
+#include "core/hierarchy.h"
+
+namespace radiosity {
+
+struct OutputMesh {
+  std::vector<double> positions;          // 3 per vertex
+  std::vector<std::int32_t> face_vertices;  // polygons' vertices, concatenated
+  std::vector<std::int32_t> face_sizes;     // per polygon
+  std::vector<float> radiance;            // 3 per vertex
+  std::vector<std::int32_t> source_face;  // per polygon: the input face
+  std::vector<std::uint8_t> source_side;  // per polygon: 0 front, 1 back
+
+  std::size_t vertex_count() const { return positions.size() / 3; }
+  std::size_t polygon_count() const { return face_sizes.size(); }
+};
+
+// `leaf_irradiance[e]` holds, for every leaf e, the total gathered H (all
+// ancestors' links pushed down plus its own) at its samples.
+OutputMesh make_output_mesh(const Hierarchy& hierarchy,
+                            const std::vector<std::array<Rgb, kMaxSamples>>& leaf_irradiance);
+
+}  // namespace radiosity

@@ -1,0 +1,61 @@
+// The scene the solver sees: input faces checked and turned into planar patches
+// (quads kept when planar and convex, other polygons triangulated), each with
+// its reflectance, emission and sidedness. Degenerate faces are skipped with a
+// reason; malformed input is rejected with a message naming the problem.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/color.h"
+#include "core/vec.h"
+
+namespace radiosity {
+
+// Views on the caller's arrays (numpy, without copies).
+struct SceneArrays {
+  std::span<const double> positions;       // 3 per vertex
+  std::span<const std::int64_t> face_vertices;  // all faces' vertex indices, concatenated
+  std::span<const std::int64_t> face_sizes;     // vertices per face
+  std::span<const double> reflectance;     // 3 per face, in [0, 1]
+  std::span<const double> emission;        // 3 per face, radiance >= 0
+  std::span<const std::uint8_t> two_sided;  // per face, or empty: every face two-sided
+};
+
+// A planar, convex piece of one input face: the top of the element hierarchy.
+struct Patch {
+  std::array<dvec3, 4> corners{};  // counter-clockwise about `normal`
+  std::uint8_t corner_count = 0;   // 3 or 4
+  bool two_sided = true;           // the back side receives, reflects and emits too
+  std::uint32_t face = 0;          // index of the input face
+  dvec3 normal{0.0};               // front side
+  double area = 0.0;
+  Rgb reflectance{0.0f};
+  Rgb emission{0.0f};
+};
+
+struct SkippedFace {
+  std::uint32_t face;
+  std::string reason;
+};
+
+struct Scene {
+  std::vector<Patch> patches;
+  std::vector<SkippedFace> skipped;
+  std::size_t face_count = 0;
+  std::size_t vertex_count = 0;
+  double total_area = 0.0;          // one side of every patch
+  double emitted_power = 0.0;       // sum of luminance(L_e) x area over emitting sides
+  double diameter = 0.0;            // of the scene's bounding box
+  // Radiance the emitted power would give if spread over every surface: the
+  // brightness scale that makes the oracles' thresholds relative (DESIGN s3).
+  double reference_radiance() const { return emitted_power / total_area; }
+};
+
+// Validates and converts; throws std::invalid_argument with a clear message.
+Scene make_scene(const SceneArrays& arrays);
+
+}  // namespace radiosity

@@ -1,0 +1,448 @@
+#include "core/solver.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace radiosity {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Threshold range of each oracle over quality (0, 1], log-spaced. Measured on
+// the bundled scenes so that the ends mean "barely refined" and "as fine as
+// the minimum element size allows" (see README, "Quality").
+struct ThresholdRange {
+  double coarse, fine;
+};
+
+ThresholdRange threshold_range(Oracle oracle) {
+  switch (oracle) {
+    case Oracle::Standard: return {1e-2, 1e-7};
+    case Oracle::Perceptual: return {1.0, 1e-4};
+    case Oracle::Gradient: return {1e-1, 1e-6};
+  }
+  return {1.0, 1e-4};
+}
+
+enum class Split : std::uint8_t { None, Receiver, Emitter };
+
+class Solver {
+ public:
+  Solver(const Scene& scene, const SolveOptions& options, const ProgressCallback& progress,
+         const CancelCheck& cancel)
+      : scene_(scene),
+        options_(options),
+        progress_(progress),
+        cancel_(cancel),
+        start_(Clock::now()),
+        hierarchy_(scene),
+        occluders_(make_scene_occluders(scene, options.visibility)),
+        evaluator_{hierarchy_, occluders_, options.visibility, options.rays, options.oracle},
+        scale_(oracle_scale(options.oracle, scene.reference_radiance(), scene.total_area)),
+        min_area_(options.min_element_area * scene.total_area) {}
+
+  SolveResult run();
+
+ private:
+  bool cancelled() const {
+    if (!stopped_ && cancel_ && cancel_()) stopped_ = true;
+    return stopped_;
+  }
+  double elapsed() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+  bool out_of_time() const { return options_.time_budget && elapsed() > *options_.time_budget; }
+
+  void report(const std::string& phase, double fraction);
+  void link_initially();
+  std::vector<Link> evaluate_links(std::vector<Link>&& candidates);
+  bool refine(double threshold);
+  Split choose_split(const Link& link, double threshold) const;
+  bool can_split(std::int32_t e) const { return hierarchy_.element(e).area / 4.0 >= min_area_; }
+  void gather();
+  double push_pull();
+  double iterate(double threshold, int max_iterations, double tolerance);
+  void snapshot(double threshold);
+  void track_memory();
+
+  const Scene& scene_;
+  const SolveOptions options_;
+  const ProgressCallback& progress_;
+  const CancelCheck& cancel_;
+  mutable bool stopped_ = false;
+  const Clock::time_point start_;
+  Hierarchy hierarchy_;
+  SceneOccluders occluders_;
+  LinkEvaluator evaluator_;
+  const double scale_;
+  const double min_area_;
+  std::vector<Link> links_;
+  SolveResult result_;     // the last complete pass
+  bool have_result_ = false;
+  bool budget_hit_ = false;
+  int pass_ = 0, passes_ = 1;
+  double threshold_ = std::numeric_limits<double>::infinity();
+  SolveStats stats_;
+};
+
+void Solver::report(const std::string& phase, double fraction) {
+  if (!progress_) return;
+  SolveProgress p;
+  p.pass = pass_;
+  p.passes = passes_;
+  p.phase = phase;
+  p.elements = hierarchy_.elements().size();
+  p.links = links_.size();
+  p.threshold = threshold_;
+  p.seconds = elapsed();
+  p.fraction = std::clamp(fraction, 0.0, 1.0);
+  progress_(p);
+}
+
+void Solver::track_memory() {
+  stats_.element_bytes = hierarchy_.memory_bytes();
+  stats_.link_bytes = links_.capacity() * sizeof(Link);
+  stats_.peak_bytes = std::max(stats_.peak_bytes, stats_.element_bytes + stats_.link_bytes);
+}
+
+// Evaluates links in parallel, each into its own slot, and keeps the visible
+// ones in their original order: the result does not depend on the thread count.
+std::vector<Link> Solver::evaluate_links(std::vector<Link>&& candidates) {
+  std::vector<std::uint8_t> visible(candidates.size(), 0);
+  tbb::enumerable_thread_specific<LinkTimings> timings;
+  // Chunks keep cancellation prompt without a check per link.
+  const size_t chunk = 4096;
+  for (size_t begin = 0; begin < candidates.size() && !cancelled(); begin += chunk) {
+    const size_t end = std::min(candidates.size(), begin + chunk);
+    tbb::parallel_for(tbb::blocked_range<size_t>(begin, end), [&](const auto& range) {
+      LinkTimings& local = timings.local();
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        visible[i] = evaluator_.evaluate(candidates[i], local) ? 1 : 0;
+      }
+    });
+  }
+  for (const LinkTimings& t : timings) stats_.link_cpu += t;
+  size_t kept = 0;
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    if (visible[i]) candidates[kept++] = candidates[i];
+  }
+  candidates.resize(kept);
+  stats_.peak_bytes = std::max(stats_.peak_bytes, hierarchy_.memory_bytes() +
+                                                      links_.capacity() * sizeof(Link) +
+                                                      candidates.capacity() * sizeof(Link));
+  return std::move(candidates);
+}
+
+// Links between every pair of facing top-level patch sides that can exchange
+// light: the receiver reflects, the emitter emits or reflects. The facing test
+// is cheap and runs first; visibility only for the pairs that pass it.
+void Solver::link_initially() {
+  const auto start = Clock::now();
+  std::vector<std::int32_t> receivers, sources;
+  for (std::uint32_t p = 0; p < scene_.patches.size(); ++p) {
+    const Patch& patch = scene_.patches[p];
+    const bool reflects = luminance(patch.reflectance) > 0.0;
+    const bool emits = luminance(patch.emission) > 0.0;
+    for (int side = 0; side < 2; ++side) {
+      const std::int32_t root = hierarchy_.root(p, side);
+      if (root == kNone) continue;
+      if (reflects) receivers.push_back(root);
+      if (reflects || emits) sources.push_back(root);
+    }
+  }
+  // Receivers in blocks, so the candidate list stays small for large scenes.
+  const size_t block = 64;
+  for (size_t begin = 0; begin < receivers.size() && !cancelled(); begin += block) {
+    const size_t end = std::min(receivers.size(), begin + block);
+    std::vector<std::vector<Link>> per_receiver(end - begin);
+    tbb::parallel_for(tbb::blocked_range<size_t>(begin, end), [&](const auto& range) {
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        const Element& r = hierarchy_.element(receivers[i]);
+        for (std::int32_t q : sources) {
+          const Element& s = hierarchy_.element(q);
+          if (s.patch == r.patch) continue;
+          if (!elements_face_each_other(hierarchy_, r, s)) continue;
+          Link link;
+          link.receiver = receivers[i];
+          link.emitter = q;
+          per_receiver[i - begin].push_back(link);
+        }
+      }
+    });
+    std::vector<Link> candidates;
+    for (auto& list : per_receiver) candidates.insert(candidates.end(), list.begin(), list.end());
+    std::vector<Link> visible = evaluate_links(std::move(candidates));
+    links_.insert(links_.end(), visible.begin(), visible.end());
+    report("linking", 0.1 * static_cast<double>(end) / static_cast<double>(receivers.size()));
+  }
+  for (const Link& l : links_) hierarchy_.element(l.receiver).has_links = 1;
+  stats_.seconds_linking = std::chrono::duration<double>(Clock::now() - start).count();
+  track_memory();
+}
+
+// The refinement policy shared by every oracle (DESIGN s5): split the larger
+// of receiver and emitter unless it is at the minimum size, then the other.
+Split Solver::choose_split(const Link& link, double threshold) const {
+  const Element& p = hierarchy_.element(link.receiver);
+  const Element& q = hierarchy_.element(link.emitter);
+  const double brightness = luminance(hierarchy_.reflectance(p) * q.radiance);
+  if (!(brightness * link.oracle / scale_ > threshold)) return Split::None;
+  const bool receiver_first = p.area >= q.area;
+  const std::int32_t first = receiver_first ? link.receiver : link.emitter;
+  const std::int32_t second = receiver_first ? link.emitter : link.receiver;
+  if (can_split(first)) return receiver_first ? Split::Receiver : Split::Emitter;
+  if (can_split(second)) return receiver_first ? Split::Emitter : Split::Receiver;
+  return Split::None;
+}
+
+// Refines every link above the threshold, repeatedly, until none is. Returns
+// whether anything changed.
+bool Solver::refine(double threshold) {
+  if (!std::isfinite(threshold)) return false;
+  bool changed = false;
+  while (!cancelled() && !budget_hit_ && !out_of_time()) {
+    std::vector<Split> decision(links_.size(), Split::None);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, links_.size()), [&](const auto& range) {
+      for (size_t i = range.begin(); i != range.end(); ++i) decision[i] = choose_split(links_[i], threshold);
+    });
+    // Subdivide in link order (deterministic), within the element budget.
+    std::vector<Link> kept, fresh;
+    for (size_t i = 0; i < links_.size(); ++i) {
+      const Link& link = links_[i];
+      if (decision[i] != Split::None) {
+        const std::int32_t target = decision[i] == Split::Receiver ? link.receiver : link.emitter;
+        const bool split_already = !hierarchy_.element(target).is_leaf();
+        if (!split_already && options_.max_elements &&
+            hierarchy_.elements().size() + 4 > *options_.max_elements) {
+          budget_hit_ = true;
+          decision[i] = Split::None;
+        } else {
+          const std::int32_t child = hierarchy_.subdivide(target);
+          for (std::int32_t c = child; c < child + 4; ++c) {
+            Link l;
+            l.receiver = decision[i] == Split::Receiver ? c : link.receiver;
+            l.emitter = decision[i] == Split::Emitter ? c : link.emitter;
+            fresh.push_back(l);
+          }
+          continue;
+        }
+      }
+      kept.push_back(link);
+    }
+    if (fresh.empty()) break;
+    changed = true;
+    std::vector<Link> made = evaluate_links(std::move(fresh));
+    if (cancelled()) break;  // a partial evaluation is discarded with the pass
+    for (const Link& l : made) hierarchy_.element(l.receiver).has_links = 1;
+    kept.insert(kept.end(), made.begin(), made.end());
+    links_ = std::move(kept);
+    track_memory();
+    report("refining", (pass_ + 0.5) / (passes_ + 1.0));
+  }
+  return changed;
+}
+
+// H_p[s] = sum over p's links of F_s L_q, per receiver in link order.
+void Solver::gather() {
+  auto& elements = hierarchy_.elements();
+  for (Element& e : elements) e.gathered.fill(Rgb(0.0f));
+  // Group links by receiver (counting sort keeps link order within a receiver).
+  std::vector<std::uint32_t> offset(elements.size() + 1, 0);
+  for (const Link& l : links_) ++offset[static_cast<size_t>(l.receiver) + 1];
+  for (size_t i = 1; i < offset.size(); ++i) offset[i] += offset[i - 1];
+  std::vector<std::uint32_t> order(links_.size());
+  {
+    std::vector<std::uint32_t> next(offset.begin(), offset.end() - 1);
+    for (std::uint32_t i = 0; i < links_.size(); ++i) order[next[static_cast<size_t>(links_[i].receiver)]++] = i;
+  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, elements.size()), [&](const auto& range) {
+    for (size_t e = range.begin(); e != range.end(); ++e) {
+      std::array<glm::dvec3, kMaxSamples> h{};
+      for (std::uint32_t k = offset[e]; k < offset[e + 1]; ++k) {
+        const Link& l = links_[order[k]];
+        const glm::dvec3 radiance(hierarchy_.element(l.emitter).radiance);
+        for (int s = 0; s < kMaxSamples; ++s) h[static_cast<size_t>(s)] += static_cast<double>(l.form_factor[static_cast<size_t>(s)]) * radiance;
+      }
+      for (int s = 0; s < kMaxSamples; ++s) elements[e].gathered[static_cast<size_t>(s)] = Rgb(h[static_cast<size_t>(s)]);
+    }
+  });
+}
+
+// Push H down with each element's interpolant, pull L up as area averages.
+// Returns the relative change of radiance, area-weighted over leaves.
+struct Change {
+  double delta = 0.0, total = 0.0;
+};
+
+Rgb push_pull_element(Hierarchy& h, std::int32_t index, const std::array<Rgb, kMaxSamples>& down,
+                      Change& change, std::vector<std::array<Rgb, kMaxSamples>>* leaf_out) {
+  Element& e = h.element(index);
+  std::array<Rgb, kMaxSamples> total;
+  for (int s = 0; s < kMaxSamples; ++s) total[static_cast<size_t>(s)] = down[static_cast<size_t>(s)] + e.gathered[static_cast<size_t>(s)];
+  Rgb radiance;
+  if (e.is_leaf()) {
+    radiance = h.emission(e) + h.reflectance(e) * Interpolant::average(e.corner_count, total);
+    change.delta += std::abs(luminance(radiance) - luminance(e.radiance)) * e.area;
+    change.total += luminance(radiance) * e.area;
+    if (leaf_out) (*leaf_out)[static_cast<size_t>(index)] = total;
+  } else {
+    glm::dvec3 sum(0.0);
+    double area = 0.0;
+    const std::int32_t first = e.first_child;
+    const int corners = e.corner_count;
+    for (int c = 0; c < 4; ++c) {
+      std::array<Rgb, kMaxSamples> child_down{};
+      for (int s = 0; s <= corners; ++s) child_down[static_cast<size_t>(s)] = Interpolant::at_child_sample(corners, total, c, s);
+      const Rgb child = push_pull_element(h, first + c, child_down, change, leaf_out);
+      const double child_area = h.element(first + c).area;
+      sum += child_area * glm::dvec3(child);
+      area += child_area;
+    }
+    radiance = Rgb(sum / area);
+  }
+  h.element(index).radiance = radiance;
+  return radiance;
+}
+
+double push_pull_all(Hierarchy& h, std::vector<std::array<Rgb, kMaxSamples>>* leaf_out) {
+  const size_t roots = h.root_count();
+  std::vector<Change> changes(roots);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, roots), [&](const auto& range) {
+    for (size_t r = range.begin(); r != range.end(); ++r) {
+      const std::int32_t root = h.root(static_cast<std::uint32_t>(r / 2), static_cast<int>(r % 2));
+      if (root != kNone) push_pull_element(h, root, {}, changes[r], leaf_out);
+    }
+  });
+  Change sum;
+  for (const Change& c : changes) sum.delta += c.delta, sum.total += c.total;
+  return sum.total > 0.0 ? sum.delta / sum.total : 0.0;
+}
+
+double Solver::push_pull() { return push_pull_all(hierarchy_, nullptr); }
+
+// Refine, gather, push/pull until converged (or `max_iterations`). Returns the
+// last residual.
+double Solver::iterate(double threshold, int max_iterations, double tolerance) {
+  double residual = 0.0;
+  for (int i = 0; i < max_iterations && !cancelled(); ++i) {
+    const bool refined = refine(threshold);
+    if (cancelled()) break;
+    const auto start = Clock::now();
+    gather();
+    residual = push_pull();
+    stats_.seconds_gather += std::chrono::duration<double>(Clock::now() - start).count();
+    ++stats_.iterations;
+    stats_.residual = residual;
+    if (!refined && residual < tolerance) break;
+    if (out_of_time() && !refined && i > 0 && residual < 1e3 * tolerance) break;
+  }
+  return residual;
+}
+
+void Solver::snapshot(double threshold) {
+  std::vector<std::array<Rgb, kMaxSamples>> leaf(hierarchy_.elements().size());
+  push_pull_all(hierarchy_, &leaf);
+  result_.mesh = make_output_mesh(hierarchy_, leaf);
+  stats_.threshold = threshold;
+  have_result_ = true;
+}
+
+SolveResult Solver::run() {
+  report("linking", 0.0);
+  link_initially();
+  const bool fixed_bounces = options_.bounces.has_value();
+  const double target = quality_threshold(options_.oracle, options_.quality);
+
+  // Threshold of each pass: pass 0 solves without refinement, later passes
+  // lower the threshold geometrically to the target. Fixed bounces: one pass.
+  std::vector<double> thresholds;
+  if (fixed_bounces) {
+    thresholds.push_back(target);
+  } else {
+    thresholds.push_back(std::numeric_limits<double>::infinity());
+    if (std::isfinite(target)) {
+      const int steps = std::max(1, static_cast<int>(std::ceil(6 * options_.quality)));
+      for (int k = 1; k <= steps; ++k) {
+        thresholds.push_back(quality_threshold(options_.oracle, options_.quality * k / steps));
+      }
+    }
+  }
+  passes_ = static_cast<int>(thresholds.size());
+  stats_.stopped_by = "quality";
+  if (!cancelled()) snapshot(std::numeric_limits<double>::infinity());  // emitters only
+  for (pass_ = 0; pass_ < passes_; ++pass_) {
+    if (cancelled()) break;
+    threshold_ = thresholds[static_cast<size_t>(pass_)];
+    const bool last = pass_ + 1 == passes_;
+    if (fixed_bounces) {
+      iterate(threshold_, *options_.bounces, -1.0);
+    } else {
+      iterate(threshold_, options_.max_iterations, last ? options_.tolerance : 1e-3);
+    }
+    if (cancelled()) break;
+    snapshot(threshold_);
+    stats_.passes = pass_ + 1;
+    report("pass", (pass_ + 1.0) / passes_);
+    if (budget_hit_) {
+      stats_.stopped_by = "max_elements";
+      break;
+    }
+    if (out_of_time()) {
+      stats_.stopped_by = "time_budget";
+      break;
+    }
+  }
+  if (cancelled()) {
+    stats_.cancelled = true;
+    stats_.stopped_by = "cancel";
+  }
+  const auto& elements = hierarchy_.elements();
+  stats_.elements = elements.size();
+  stats_.leaves = static_cast<size_t>(std::count_if(elements.begin(), elements.end(),
+                                                    [](const Element& e) { return e.is_leaf(); }));
+  stats_.links = links_.size();
+  stats_.skipped_faces = scene_.skipped.size();
+  track_memory();
+  stats_.seconds = elapsed();
+  result_.stats = stats_;
+  report("done", 1.0);
+  return std::move(result_);
+}
+
+}  // namespace
+
+double quality_threshold(Oracle oracle, double quality) {
+  if (!(quality > 0.0)) return std::numeric_limits<double>::infinity();
+  const ThresholdRange range = threshold_range(oracle);
+  const double q = std::min(quality, 1.0);
+  return range.coarse * std::pow(range.fine / range.coarse, q);
+}
+
+SolveResult solve(const Scene& scene, const SolveOptions& options, const ProgressCallback& progress,
+                  const CancelCheck& cancel) {
+  if (!(options.quality >= 0.0 && options.quality <= 1.0)) {
+    throw std::invalid_argument("quality must lie in [0, 1]");
+  }
+  if (options.max_elements && *options.max_elements == 0) {
+    throw std::invalid_argument("max_elements must be positive");
+  }
+  if (options.time_budget && !(*options.time_budget > 0.0)) {
+    throw std::invalid_argument("time_budget must be positive seconds");
+  }
+  if (options.rays < 1 || options.rays > 65536) throw std::invalid_argument("rays must lie in [1, 65536]");
+  if (options.bounces && *options.bounces < 1) throw std::invalid_argument("bounces must be at least 1");
+  if (options.threads && *options.threads < 1) throw std::invalid_argument("threads must be at least 1");
+  if (!(options.min_element_area > 0.0 && options.min_element_area < 1.0)) {
+    throw std::invalid_argument("min_element_area must lie in (0, 1)");
+  }
+  tbb::task_arena arena(options.threads ? *options.threads : tbb::task_arena::automatic);
+  return arena.execute([&] { return Solver(scene, options, progress, cancel).run(); });
+}
+
+}  // namespace radiosity

@@ -1,0 +1,91 @@
+// Hierarchical radiosity (Hanrahan, Salzman and Aupperle 1991) with a pluggable
+// refinement oracle (DESIGN s5-6): initial links between facing top-level
+// patches, then passes of decreasing threshold, each iterating
+// refine -> gather -> push/pull until the radiance converges. Every pass reuses
+// the elements and links already made, so the solve can stop at any time (a
+// budget, or cancel) with the best complete solution so far.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "core/link_transport.h"
+#include "core/oracle.h"
+#include "core/output_mesh.h"
+#include "core/scene.h"
+
+namespace radiosity {
+
+struct SolveOptions {
+  Oracle oracle = Oracle::Perceptual;
+  // 0 = no refinement (the coarsest solution), 1 = the finest the oracle's
+  // threshold scale allows; see quality_threshold().
+  double quality = 0.5;
+  std::optional<std::size_t> max_elements;  // element budget
+  std::optional<double> time_budget;        // seconds
+  VisibilityMode visibility = VisibilityMode::Exact;
+  int rays = 16;
+  // When set: one pass at the target threshold, with exactly this many
+  // refine/gather/push-pull iterations from L = L_e (the source's 3-iteration runs).
+  std::optional<int> bounces;
+  std::optional<int> threads;  // default: all cores
+  // Smallest element, as a fraction of the scene's total area.
+  double min_element_area = 1e-6;
+  double tolerance = 1e-6;  // relative change of radiance that counts as converged
+  int max_iterations = 5000;
+};
+
+struct SolveProgress {
+  int pass = 0;
+  int passes = 0;
+  std::string phase;  // "linking", "refining", "gathering", "done"
+  std::size_t elements = 0;
+  std::size_t links = 0;
+  double threshold = 0.0;
+  double seconds = 0.0;
+  double fraction = 0.0;  // rough overall progress in [0, 1]
+};
+
+struct SolveStats {
+  std::size_t elements = 0;
+  std::size_t leaves = 0;
+  std::size_t links = 0;
+  int passes = 0;
+  int iterations = 0;
+  double residual = 0.0;     // relative change of the last iteration
+  double threshold = 0.0;    // of the last complete pass
+  std::size_t skipped_faces = 0;
+  bool cancelled = false;
+  std::string stopped_by;    // "quality", "max_elements", "time_budget", "cancel"
+  double seconds = 0.0;
+  double seconds_linking = 0.0;
+  LinkTimings link_cpu;      // CPU seconds over all threads
+  double seconds_gather = 0.0;  // gather and push/pull, wall clock
+  std::size_t element_bytes = 0;
+  std::size_t link_bytes = 0;
+  std::size_t peak_bytes = 0;  // peak of the solver's own structures
+};
+
+struct SolveResult {
+  OutputMesh mesh;
+  SolveStats stats;
+};
+
+// Thresholds of the oracle at a quality level: log-spaced from the largest
+// (quality -> 0) to the smallest (quality = 1). Quality 0 means no refinement.
+double quality_threshold(Oracle oracle, double quality);
+
+using ProgressCallback = std::function<void(const SolveProgress&)>;
+
+// Polled often from the solving thread; true stops the solve.
+using CancelCheck = std::function<bool()>;
+
+// Solves; throws std::invalid_argument for bad options. When `cancelled`
+// turns true (set from another thread) the solve returns the last complete
+// pass promptly.
+SolveResult solve(const Scene& scene, const SolveOptions& options,
+                  const ProgressCallback& progress = {}, const CancelCheck& cancelled = {});
+
+}  // namespace radiosity

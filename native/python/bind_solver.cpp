@@ -1,0 +1,284 @@
+// Python access to the solver: Scene, solve(), Result and CancelToken.
+// numpy in (validated, no copies of the caller's arrays), numpy out (the
+// result's vectors are handed over, not copied); the GIL is released while
+// solving, and the progress callback re-acquires it.
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <sys/resource.h>
+
+#include <atomic>
+#include <exception>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "core/scene.h"
+#include "core/solver.h"
+#include "python/bindings.h"
+#include "python/numpy_input.h"
+
+namespace py = pybind11;
+
+namespace radiosity::python {
+namespace {
+
+struct CancelToken {
+  std::atomic<bool> flag{false};
+};
+
+template <class T>
+using Array = py::array_t<T, py::array::c_style | py::array::forcecast>;
+
+template <class T>
+Array<T> read_typed(const py::handle& object, const std::string& name, std::vector<py::ssize_t> shape) {
+  if (object.is_none()) throw std::invalid_argument(name + " must be an array, got None");
+  Array<T> a;
+  try {
+    a = Array<T>::ensure(object);
+  } catch (const py::error_already_set&) {
+    a = {};
+  }
+  if (!a) throw std::invalid_argument(name + " must be convertible to a numeric array");
+  bool ok = a.ndim() == static_cast<py::ssize_t>(shape.size());
+  for (size_t i = 0; ok && i < shape.size(); ++i) {
+    ok = shape[i] < 0 || a.shape(static_cast<py::ssize_t>(i)) == shape[i];
+  }
+  if (!ok) {
+    std::string got = "(";
+    for (py::ssize_t i = 0; i < a.ndim(); ++i) got += (i ? ", " : "") + std::to_string(a.shape(i));
+    throw std::invalid_argument(name + " has the wrong shape " + got + (a.ndim() == 1 ? ",)" : ")"));
+  }
+  return a;
+}
+
+// Integer input must hold integers: a float array is accepted only if whole.
+Array<std::int64_t> read_indices(const py::handle& object, const std::string& name) {
+  if (!object.is_none()) {
+    const auto as_array = py::array::ensure(object);
+    if (as_array && as_array.dtype().kind() == 'f') {
+      const auto floats = read_typed<double>(object, name, {-1});
+      for (py::ssize_t i = 0; i < floats.size(); ++i) {
+        const double v = floats.data()[i];
+        if (!std::isfinite(v) || v != std::floor(v)) {
+          throw std::invalid_argument(name + " must hold integers (index " + std::to_string(i) + ")");
+        }
+      }
+    }
+  }
+  return read_typed<std::int64_t>(object, name, {-1});
+}
+
+Scene make_python_scene(const py::handle& positions, const py::handle& face_vertices,
+                        const py::handle& face_sizes, const py::handle& reflectance,
+                        const py::handle& emission, const py::handle& two_sided) {
+  const auto p = read_typed<double>(positions, "positions", {-1, 3});
+  const auto fv = read_indices(face_vertices, "face_vertices");
+  const auto fs = read_indices(face_sizes, "face_sizes");
+  const auto faces = fs.shape(0);
+  const auto rho = read_typed<double>(reflectance, "reflectance", {faces, 3});
+  const auto le = read_typed<double>(emission, "emission", {faces, 3});
+  Array<std::uint8_t> sided;
+  if (!two_sided.is_none()) sided = read_typed<std::uint8_t>(two_sided, "two_sided", {faces});
+  SceneArrays arrays;
+  arrays.positions = {p.data(), static_cast<size_t>(p.size())};
+  arrays.face_vertices = {fv.data(), static_cast<size_t>(fv.size())};
+  arrays.face_sizes = {fs.data(), static_cast<size_t>(fs.size())};
+  arrays.reflectance = {rho.data(), static_cast<size_t>(rho.size())};
+  arrays.emission = {le.data(), static_cast<size_t>(le.size())};
+  if (sided) arrays.two_sided = {sided.data(), static_cast<size_t>(sided.size())};
+  return make_scene(arrays);
+}
+
+// Hands a vector to numpy without copying: the array owns it through a capsule.
+template <class T>
+py::array_t<T> hand_over(std::vector<T>&& v, std::vector<py::ssize_t> shape) {
+  auto* owner = new std::vector<T>(std::move(v));
+  py::capsule free_when_done(owner, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+  return py::array_t<T>(shape, owner->data(), free_when_done);
+}
+
+struct PyResult {
+  py::array_t<double> positions;
+  py::array_t<std::int32_t> face_vertices, face_sizes, source_face;
+  py::array_t<float> radiance;
+  py::array_t<std::uint8_t> source_side;
+  py::dict stats;
+};
+
+py::dict stats_dict(const SolveStats& s) {
+  py::dict d;
+  d["elements"] = s.elements;
+  d["leaves"] = s.leaves;
+  d["links"] = s.links;
+  d["passes"] = s.passes;
+  d["iterations"] = s.iterations;
+  d["residual"] = s.residual;
+  d["threshold"] = s.threshold;
+  d["skipped_faces"] = s.skipped_faces;
+  d["cancelled"] = s.cancelled;
+  d["stopped_by"] = s.stopped_by;
+  d["seconds"] = s.seconds;
+  d["seconds_linking"] = s.seconds_linking;
+  d["seconds_gather"] = s.seconds_gather;
+  d["cpu_visibility"] = s.link_cpu.visibility;
+  d["cpu_form_factors"] = s.link_cpu.form_factors;
+  d["cpu_oracle"] = s.link_cpu.oracle;
+  d["element_bytes"] = s.element_bytes;
+  d["link_bytes"] = s.link_bytes;
+  d["peak_bytes"] = s.peak_bytes;
+  d["bytes_per_element"] = s.elements ? static_cast<double>(s.element_bytes) / static_cast<double>(s.elements) : 0.0;
+  d["bytes_per_link"] = s.links ? static_cast<double>(s.link_bytes) / static_cast<double>(s.links) : 0.0;
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  d["peak_rss_bytes"] = static_cast<std::size_t>(usage.ru_maxrss) * 1024;
+  return d;
+}
+
+PyResult to_python(SolveResult&& r) {
+  PyResult out;
+  OutputMesh& m = r.mesh;
+  const auto vertices = static_cast<py::ssize_t>(m.vertex_count());
+  const auto polygons = static_cast<py::ssize_t>(m.polygon_count());
+  const auto corners = static_cast<py::ssize_t>(m.face_vertices.size());
+  out.positions = hand_over(std::move(m.positions), {vertices, 3});
+  out.radiance = hand_over(std::move(m.radiance), {vertices, 3});
+  out.face_vertices = hand_over(std::move(m.face_vertices), {corners});
+  out.face_sizes = hand_over(std::move(m.face_sizes), {polygons});
+  out.source_face = hand_over(std::move(m.source_face), {polygons});
+  out.source_side = hand_over(std::move(m.source_side), {polygons});
+  out.stats = stats_dict(r.stats);
+  return out;
+}
+
+Oracle read_oracle(const std::string& name) {
+  const auto oracle = parse_oracle(name);
+  if (!oracle) {
+    throw std::invalid_argument("oracle must be 'standard', 'perceptual' or 'gradient', got '" + name + "'");
+  }
+  return *oracle;
+}
+
+VisibilityMode read_visibility(const std::string& name) {
+  if (name == "exact") return VisibilityMode::Exact;
+  if (name == "sampled") return VisibilityMode::Sampled;
+  throw std::invalid_argument("visibility must be 'exact' or 'sampled', got '" + name + "'");
+}
+
+PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
+                  std::optional<std::int64_t> max_elements, std::optional<double> time_budget,
+                  const std::string& visibility, int rays, std::optional<int> bounces,
+                  std::optional<int> threads, const py::object& progress,
+                  const py::object& cancel, double min_element_area) {
+  SolveOptions options;
+  options.oracle = read_oracle(oracle);
+  options.quality = quality;
+  if (max_elements) {
+    if (*max_elements < 1) throw std::invalid_argument("max_elements must be positive");
+    options.max_elements = static_cast<std::size_t>(*max_elements);
+  }
+  options.time_budget = time_budget;
+  options.visibility = read_visibility(visibility);
+  options.rays = rays;
+  options.bounces = bounces;
+  options.threads = threads;
+  options.min_element_area = min_element_area;
+
+  const CancelToken* token = nullptr;
+  if (!cancel.is_none()) {
+    if (!py::isinstance<CancelToken>(cancel)) throw std::invalid_argument("cancel must be a CancelToken or None");
+    token = cancel.cast<CancelToken*>();
+  }
+  if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
+    throw std::invalid_argument("progress must be callable or None");
+  }
+  // A failing callback stops the solve; its exception is raised afterwards.
+  std::exception_ptr callback_error;
+  std::atomic<bool> callback_failed{false};
+  ProgressCallback callback;
+  if (!progress.is_none()) {
+    callback = [&](const SolveProgress& p) {
+      py::gil_scoped_acquire gil;
+      if (callback_error) return;
+      try {
+        py::dict d;
+        d["pass"] = p.pass;
+        d["passes"] = p.passes;
+        d["phase"] = p.phase;
+        d["elements"] = p.elements;
+        d["links"] = p.links;
+        d["threshold"] = p.threshold;
+        d["seconds"] = p.seconds;
+        d["fraction"] = p.fraction;
+        progress(d);
+      } catch (...) {
+        callback_error = std::current_exception();
+        callback_failed = true;
+      }
+    };
+  }
+  const CancelCheck cancelled = [&] { return callback_failed.load() || (token && token->flag.load()); };
+  SolveResult result;
+  {
+    py::gil_scoped_release release;
+    result = solve(scene, options, callback, cancelled);
+  }
+  if (callback_error) std::rethrow_exception(callback_error);
+  return to_python(std::move(result));
+}
+
+}  // namespace
+
+void bind_solver(py::module_& m) {
+  py::class_<CancelToken>(m, "CancelToken",
+                          "A flag another thread can set to stop a solve; the solve then returns the "
+                          "last complete pass.")
+      .def(py::init<>())
+      .def("cancel", [](CancelToken& t) { t.flag = true; }, "Ask the solve to stop.")
+      .def_property_readonly("cancelled", [](const CancelToken& t) { return t.flag.load(); });
+
+  py::class_<Scene>(m, "Scene",
+                    "Scene(positions, face_vertices, face_sizes, reflectance, emission, two_sided=None)\n\n"
+                    "positions (V, 3) float; face_vertices: all faces' vertex indices concatenated;\n"
+                    "face_sizes (F,) vertices per face (3 or more; larger polygons are triangulated);\n"
+                    "reflectance (F, 3) in [0, 1]; emission (F, 3) radiance >= 0; two_sided (F,) bool,\n"
+                    "default all True (a one-sided face has only its front: area lights).\n"
+                    "Degenerate faces are skipped and listed in skipped_faces; bad input raises ValueError.")
+      .def(py::init(&make_python_scene), py::arg("positions"), py::arg("face_vertices"),
+           py::arg("face_sizes"), py::arg("reflectance"), py::arg("emission"),
+           py::arg("two_sided") = py::none())
+      .def_property_readonly("face_count", [](const Scene& s) { return s.face_count; })
+      .def_property_readonly("patch_count", [](const Scene& s) { return s.patches.size(); })
+      .def_property_readonly("total_area", [](const Scene& s) { return s.total_area; })
+      .def_property_readonly("skipped_faces", [](const Scene& s) {
+        py::list out;
+        for (const auto& k : s.skipped) out.append(py::make_tuple(k.face, k.reason));
+        return out;
+      });
+
+  py::class_<PyResult>(m, "Result", "The solved leaf mesh with per-vertex radiance.")
+      .def_readonly("positions", &PyResult::positions, "(V, 3) float64 vertex positions")
+      .def_readonly("face_vertices", &PyResult::face_vertices, "polygons' vertex indices, concatenated")
+      .def_readonly("face_sizes", &PyResult::face_sizes, "(P,) vertices per polygon")
+      .def_readonly("radiance", &PyResult::radiance, "(V, 3) float32 radiance per vertex")
+      .def_readonly("source_face", &PyResult::source_face, "(P,) input face of each polygon")
+      .def_readonly("source_side", &PyResult::source_side, "(P,) 0 front, 1 back")
+      .def_readonly("stats", &PyResult::stats, "statistics of the solve (dict)");
+
+  m.def("solve", &py_solve, py::arg("scene"), py::arg("oracle") = "perceptual",
+        py::arg("quality") = 0.5, py::arg("max_elements") = py::none(),
+        py::arg("time_budget") = py::none(), py::arg("visibility") = "exact", py::arg("rays") = 16,
+        py::arg("bounces") = py::none(), py::arg("threads") = py::none(),
+        py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
+        py::arg("min_element_area") = 1e-6,
+        "Hierarchical radiosity. oracle: 'standard' | 'perceptual' | 'gradient'; quality in\n"
+        "[0, 1] (0: no refinement); max_elements, time_budget (s): budgets; visibility:\n"
+        "'exact' | 'sampled' (rays per sample); bounces: fixed iteration count instead of\n"
+        "convergence; threads; progress(dict) callback; cancel: CancelToken.");
+  m.def("quality_threshold", [](const std::string& oracle, double quality) {
+    return quality_threshold(read_oracle(oracle), quality);
+  }, py::arg("oracle"), py::arg("quality"), "The oracle's refinement threshold at a quality level.");
+}
+
+}  // namespace radiosity::python

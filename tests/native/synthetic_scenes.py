@@ -1,0 +1,61 @@
+"""Small scenes built from arrays, for testing the native solver without Blender."""
+
+import numpy as np
+
+
+class SceneBuilder:
+    """Collects quads and triangles with their materials."""
+
+    def __init__(self):
+        self.positions, self.faces, self.reflectance, self.emission, self.two_sided = [], [], [], [], []
+
+    def polygon(self, corners, rho=(0.5, 0.5, 0.5), emission=(0, 0, 0), two_sided=True):
+        start = len(self.positions)
+        self.positions.extend(np.asarray(c, float) for c in corners)
+        self.faces.append(list(range(start, start + len(corners))))
+        self.reflectance.append(np.broadcast_to(rho, 3))
+        self.emission.append(np.broadcast_to(emission, 3))
+        self.two_sided.append(two_sided)
+        return len(self.faces) - 1
+
+    def box(self, lo, hi, rho=(0.5, 0.5, 0.5), emission=(0, 0, 0), inward=False):
+        """Six quads of an axis-aligned box, facing out (or in, for a room)."""
+        x0, y0, z0 = lo
+        x1, y1, z1 = hi
+        quads = [
+            [(x0, y0, z0), (x0, y1, z0), (x1, y1, z0), (x1, y0, z0)],  # bottom, -z
+            [(x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)],  # top, +z
+            [(x0, y0, z0), (x1, y0, z0), (x1, y0, z1), (x0, y0, z1)],  # -y
+            [(x0, y1, z0), (x0, y1, z1), (x1, y1, z1), (x1, y1, z0)],  # +y
+            [(x0, y0, z0), (x0, y0, z1), (x0, y1, z1), (x0, y1, z0)],  # -x
+            [(x1, y0, z0), (x1, y1, z0), (x1, y1, z1), (x1, y0, z1)],  # +x
+        ]
+        faces = []
+        for q in quads:
+            faces.append(self.polygon(q[::-1] if inward else q, rho, emission))
+        return faces
+
+    def arrays(self):
+        return dict(
+            positions=np.array(self.positions, float),
+            face_vertices=np.array([i for f in self.faces for i in f], np.int64),
+            face_sizes=np.array([len(f) for f in self.faces], np.int64),
+            reflectance=np.array(self.reflectance, float),
+            emission=np.array(self.emission, float),
+            two_sided=np.array(self.two_sided, bool),
+        )
+
+    def scene(self, rad, scale=1.0, emission_scale=1.0):
+        a = self.arrays()
+        return rad.Scene(a["positions"] * scale, a["face_vertices"], a["face_sizes"], a["reflectance"],
+                         a["emission"] * emission_scale, a["two_sided"])
+
+
+def room_with_blocker(light=5.0):
+    """A 4 x 4 x 3 room, a square ceiling light facing down, a box on the floor under it."""
+    b = SceneBuilder()
+    room = b.box((0, 0, 0), (4, 4, 3), rho=0.6, inward=True)
+    light_face = b.polygon([(1.5, 1.5, 2.99), (1.5, 2.5, 2.99), (2.5, 2.5, 2.99), (2.5, 1.5, 2.99)],
+                           rho=0.0, emission=light, two_sided=False)
+    blocker = b.box((1.6, 1.6, 0.0), (2.4, 2.4, 0.8), rho=0.5)
+    return b, dict(room=room, light=light_face, blocker=blocker)
