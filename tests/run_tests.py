@@ -103,7 +103,12 @@ def run_ctest(build, patterns, timeout, verbose):
     if patterns and not matches(name, patterns):
         cmd += ["-R", "|".join(ctest_regex(p) for p in patterns)]
     start = time.perf_counter()
-    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout * 4)
+    try:
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout * 4,
+                              stdin=subprocess.DEVNULL)
+    except (OSError, subprocess.TimeoutExpired) as err:
+        return Outcome(name, failed=1, seconds=time.perf_counter() - start,
+                       details="ctest did not complete: %s" % err)
     seconds = time.perf_counter() - start
     output = proc.stdout + proc.stderr
     if "No tests were found" in output:
