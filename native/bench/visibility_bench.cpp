@@ -128,6 +128,62 @@ void BM_ShaftCulling_BruteForce(benchmark::State& state) {
 }
 BENCHMARK(BM_ShaftCulling_BruteForce)->Unit(benchmark::kMicrosecond);
 
+// BVH builds, ours (binned SAH, one thread) and Embree's rtcBuildBVH, on random
+// scenes of 5k and 200k triangles; then shaft queries through each tree.
+std::vector<Triangle> random_triangles(std::size_t count) {
+  std::mt19937_64 rng(count);
+  std::vector<Triangle> triangles(count);
+  const double extent = 5.0 * std::cbrt(static_cast<double>(count) / 5000.0);
+  for (Triangle& t : triangles) {
+    const dvec3 c = uniform_in(rng, dvec3(-extent), dvec3(extent));
+    for (dvec3& v : t.v) v = c + uniform_in(rng, dvec3(-0.1), dvec3(0.1));
+  }
+  return triangles;
+}
+
+void BM_BuildBvh_Own(benchmark::State& state) {
+  const std::vector<Triangle> triangles = random_triangles(static_cast<std::size_t>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(build_scene_bvh(triangles).nodes.data());
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+BENCHMARK(BM_BuildBvh_Own)->Arg(5000)->Arg(200000)->Unit(benchmark::kMillisecond);
+
+void BM_BuildBvh_Embree(benchmark::State& state) {
+  const std::vector<Triangle> triangles = random_triangles(static_cast<std::size_t>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(build_scene_bvh_embree(triangles).nodes.data());
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+BENCHMARK(BM_BuildBvh_Embree)->Arg(5000)->Arg(200000)->Unit(benchmark::kMillisecond);
+
+// Shaft queries between random element pairs 1 to 3 apart, through a tree built
+// by us (arg 0) or by Embree (arg 1), 200k triangles.
+void BM_ShaftCulling_Tree(benchmark::State& state) {
+  static OccluderScene own = make_occluder_scene(random_triangles(200000));
+  static OccluderScene embree = [] {
+    OccluderScene s = own;
+    s.bvh = build_scene_bvh_embree(s.triangles);
+    return s;
+  }();
+  const OccluderScene& scene = state.range(0) == 0 ? own : embree;
+  std::mt19937_64 rng(5);
+  std::vector<std::pair<Polygon, Polygon>> links;
+  for (int i = 0; i < 256; ++i) {
+    const dvec3 c = uniform_in(rng, dvec3(-20.0), dvec3(20.0));
+    const dvec3 d = c + uniform_in(rng, dvec3(-3.0), dvec3(3.0));
+    links.push_back({{c, c + dvec3(0.5, 0, 0), c + dvec3(0.5, 0.5, 0), c + dvec3(0, 0.5, 0)},
+                     {d, d + dvec3(0, 0.5, 0), d + dvec3(0.5, 0.5, 0.1), d + dvec3(0.5, 0, 0.1)}});
+  }
+  std::size_t i = 0, candidates = 0;
+  for (auto _ : state) {
+    const ShaftCulling c = cull_shaft(scene, links[i].first, kNoFace, links[i].second, kNoFace);
+    candidates += c.candidates.size();
+    i = (i + 1) % links.size();
+  }
+  state.counters["candidates"] = static_cast<double>(candidates) / static_cast<double>(state.iterations());
+  state.counters["nodes"] = static_cast<double>(scene.bvh.nodes.size());
+}
+BENCHMARK(BM_ShaftCulling_Tree)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
 // Occluders in the pyramid from a receiver point to a unit emitter, overlapping.
 struct OccluderConfigurations {
   Polygon emitter{{-0.5, -0.5, 2.0}, {-0.5, 0.5, 2.0}, {0.5, 0.5, 2.0}, {0.5, -0.5, 2.0}};

@@ -10,17 +10,6 @@
 namespace radiosity {
 namespace {
 
-// One Embree device for the process: creating one costs milliseconds, and
-// scenes are made per solve (or per Python call). Never released.
-RTCDevice shared_device() {
-  static RTCDevice device = [] {
-    RTCDevice d = rtcNewDevice("threads=0");
-    if (!d) throw std::runtime_error("Embree: cannot create a device");
-    return d;
-  }();
-  return device;
-}
-
 // The query context carries the faces to ignore; the filter rejects hits on them.
 struct FilterContext {
   RTCIntersectContext embree;  // first member: Embree passes a pointer to it back
@@ -49,13 +38,24 @@ float end_margin(const dvec3& from, const dvec3& to) {
 
 }  // namespace
 
+// One Embree device for the process: scenes are made per solve (or per Python
+// call), devices would cost milliseconds each.
+RTCDevice shared_embree_device() {
+  static RTCDevice device = [] {
+    RTCDevice d = rtcNewDevice("threads=0");
+    if (!d) throw std::runtime_error("Embree: cannot create a device");
+    return d;
+  }();
+  return device;
+}
+
 RayScene::RayScene(std::span<const Triangle> triangles, std::span<const std::uint32_t> face)
     : face_(face.begin(), face.end()) {
   if (face_.size() != triangles.size()) {
     face_.resize(triangles.size());
     std::iota(face_.begin(), face_.end(), 0u);
   }
-  device_ = shared_device();
+  device_ = shared_embree_device();
   rtcRetainDevice(device_);
   scene_ = rtcNewScene(device_);
   rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);

@@ -19,6 +19,10 @@
 
 namespace radiosity {
 
+// The process's Embree device (created on first use, never released: creating
+// one costs milliseconds). Throws std::runtime_error if Embree cannot start.
+RTCDevice shared_embree_device();
+
 class RayScene {
  public:
   // `face` as in OccluderScene: may be empty (every triangle its own face).

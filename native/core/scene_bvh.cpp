@@ -1,8 +1,14 @@
 // Binned SAH build of the scene's BVH (see scene_bvh.h).
 #include "core/scene_bvh.h"
 
+#include <embree3/rtcore.h>
+
 #include <algorithm>
 #include <array>
+#include <new>
+#include <stdexcept>
+
+#include "core/ray_scene.h"
 
 namespace radiosity {
 namespace {
@@ -90,7 +96,114 @@ struct Builder {
   }
 };
 
+// Embree's builder hands out nodes through callbacks; these are its nodes, in
+// its thread-local memory, flattened into our layout afterwards.
+struct EmbreeNode {
+  bool leaf = false;
+};
+struct EmbreeInner : EmbreeNode {
+  EmbreeNode* child[2] = {nullptr, nullptr};
+};
+struct EmbreeLeaf : EmbreeNode {
+  std::uint32_t count = 0;
+  std::uint32_t* triangle = nullptr;  // `count` entries, stored right after the leaf
+};
+
+void* create_inner(RTCThreadLocalAllocator alloc, unsigned int, void*) {
+  return new (rtcThreadLocalAlloc(alloc, sizeof(EmbreeInner), 16)) EmbreeInner();
+}
+void set_children(void* node, void** children, unsigned int count, void*) {
+  auto* inner = static_cast<EmbreeInner*>(node);
+  for (unsigned int i = 0; i < count && i < 2; ++i) inner->child[i] = static_cast<EmbreeNode*>(children[i]);
+}
+void set_bounds(void*, const RTCBounds**, unsigned int, void*) {}  // recomputed in double
+void* create_leaf(RTCThreadLocalAllocator alloc, const RTCBuildPrimitive* prims, size_t count, void*) {
+  // Leaves hold at most maxLeafSize triangles, unless the depth limit forced more.
+  void* memory = rtcThreadLocalAlloc(alloc, sizeof(EmbreeLeaf) + count * sizeof(std::uint32_t), 16);
+  auto* leaf = new (memory) EmbreeLeaf();
+  leaf->leaf = true;
+  leaf->count = static_cast<std::uint32_t>(count);
+  leaf->triangle = reinterpret_cast<std::uint32_t*>(static_cast<unsigned char*>(memory) + sizeof(EmbreeLeaf));
+  for (std::uint32_t i = 0; i < leaf->count; ++i) leaf->triangle[i] = prims[i].primID;
+  return leaf;
+}
+
+// Depth-first copy into `bvh` (left child right after its parent); returns the
+// node's index. Boxes come from the triangles, in double precision.
+std::uint32_t flatten(const EmbreeNode* node, std::span<const Aabb> boxes, SceneBvh& bvh) {
+  const auto index = static_cast<std::uint32_t>(bvh.nodes.size());
+  bvh.nodes.emplace_back();
+  if (node->leaf) {
+    const auto* leaf = static_cast<const EmbreeLeaf*>(node);
+    Aabb box;
+    bvh.nodes[index].first = static_cast<std::uint32_t>(bvh.order.size());
+    bvh.nodes[index].count = leaf->count;
+    for (std::uint32_t i = 0; i < leaf->count; ++i) {
+      bvh.order.push_back(leaf->triangle[i]);
+      box.grow(boxes[leaf->triangle[i]]);
+    }
+    bvh.nodes[index].box = box;
+    return index;
+  }
+  const auto* inner = static_cast<const EmbreeInner*>(node);
+  flatten(inner->child[0], boxes, bvh);
+  const std::uint32_t right = flatten(inner->child[1], boxes, bvh);
+  Aabb box = bvh.nodes[index + 1].box;
+  box.grow(bvh.nodes[right].box);
+  bvh.nodes[index].box = box;
+  bvh.nodes[index].first = right;
+  bvh.nodes[index].count = 0;
+  return index;
+}
+
 }  // namespace
+
+SceneBvh build_scene_bvh_embree(std::span<const Triangle> triangles) {
+  SceneBvh bvh;
+  if (triangles.empty()) return bvh;
+  std::vector<Aabb> boxes(triangles.size());
+  // Embree may use spare room in the primitive array for spatial splits; we ask
+  // for none, so the capacity is the count.
+  std::vector<RTCBuildPrimitive> prims(triangles.size());
+  for (std::size_t i = 0; i < triangles.size(); ++i) {
+    for (const dvec3& v : triangles[i].v) boxes[i].grow(v);
+    RTCBuildPrimitive& p = prims[i];
+    // Float bounds rounded outwards (Embree only uses them to decide splits).
+    p.lower_x = std::nextafter(static_cast<float>(boxes[i].lo.x), -1e30f);
+    p.lower_y = std::nextafter(static_cast<float>(boxes[i].lo.y), -1e30f);
+    p.lower_z = std::nextafter(static_cast<float>(boxes[i].lo.z), -1e30f);
+    p.upper_x = std::nextafter(static_cast<float>(boxes[i].hi.x), 1e30f);
+    p.upper_y = std::nextafter(static_cast<float>(boxes[i].hi.y), 1e30f);
+    p.upper_z = std::nextafter(static_cast<float>(boxes[i].hi.z), 1e30f);
+    p.geomID = 0;
+    p.primID = static_cast<unsigned>(i);
+  }
+  RTCBVH handle = rtcNewBVH(shared_embree_device());
+  RTCBuildArguments args = rtcDefaultBuildArguments();
+  args.buildQuality = RTC_BUILD_QUALITY_HIGH;
+  args.maxBranchingFactor = 2;
+  args.maxDepth = 48;
+  args.minLeafSize = 1;
+  args.maxLeafSize = kLeafSize;
+  args.bvh = handle;
+  args.primitives = prims.data();
+  args.primitiveCount = prims.size();
+  args.primitiveArrayCapacity = prims.size();
+  args.createNode = create_inner;
+  args.setNodeChildren = set_children;
+  args.setNodeBounds = set_bounds;
+  args.createLeaf = create_leaf;
+  const auto* root = static_cast<const EmbreeNode*>(rtcBuildBVH(&args));
+  if (!root) {
+    rtcReleaseBVH(handle);
+    throw std::runtime_error("Embree: rtcBuildBVH failed");
+  }
+  bvh.nodes.reserve(2 * triangles.size() / kLeafSize + 1);
+  bvh.order.reserve(triangles.size());
+  flatten(root, boxes, bvh);
+  rtcReleaseBVH(handle);  // frees the nodes made in its allocator
+  return bvh;
+}
 
 SceneBvh build_scene_bvh(std::span<const Triangle> triangles) {
   SceneBvh bvh;

@@ -49,7 +49,13 @@ struct SceneBvh {
   std::vector<std::uint32_t> order;  // triangle indices, grouped by leaf
 };
 
+// Our binned SAH builder (single thread).
 SceneBvh build_scene_bvh(std::span<const Triangle> triangles);
+
+// The same tree layout built by Embree's rtcBuildBVH (SAH, its own threads),
+// boxes recomputed in double precision from the triangles. Compared with ours
+// in bench/visibility_bench.cpp.
+SceneBvh build_scene_bvh_embree(std::span<const Triangle> triangles);
 
 // Visits every triangle whose leaf box is not rejected by `keep_box(const Aabb&)`,
 // calling `visit(std::uint32_t triangle)`. Depth-first with an explicit stack.

@@ -92,6 +92,28 @@ TEST(ShaftCulling, BvhFindsWhatBruteForceFindsAndMissesNoBlocker) {
   EXPECT_GT(clear, 10);
 }
 
+TEST(ShaftCulling, EmbreeBuiltBvhFindsTheSameCandidates) {
+  std::mt19937_64 rng(43);
+  OccluderScene scene = random_scene(rng, 3000);
+  OccluderScene embree = scene;
+  embree.bvh = build_scene_bvh_embree(embree.triangles);
+  // Every triangle sits in exactly one leaf.
+  std::vector<std::uint32_t> order = embree.bvh.order;
+  std::sort(order.begin(), order.end());
+  ASSERT_EQ(order.size(), scene.triangles.size());
+  for (std::uint32_t i = 0; i < order.size(); ++i) ASSERT_EQ(order[i], i);
+  for (int i = 0; i < 200; ++i) {
+    const dvec3 c = random_point(rng, -4.0, 4.0);
+    const Polygon receiver = random_element(rng, c, 0.5);
+    const Polygon emitter = random_element(rng, c + random_point(rng, -3.0, 3.0), 0.5);
+    const ShaftCulling ours = cull_shaft(scene, receiver, kNoFace, emitter, kNoFace);
+    const ShaftCulling theirs = cull_shaft(embree, receiver, kNoFace, emitter, kNoFace);
+    const ShaftCulling brute = cull_shaft_brute_force(scene, receiver, kNoFace, emitter, kNoFace);
+    ASSERT_EQ(ours.candidates, brute.candidates);
+    ASSERT_EQ(theirs.candidates, brute.candidates);
+  }
+}
+
 TEST(ShaftCulling, WallBetweenTwoElementsIsHidden) {
   // Floor element, ceiling element, and a wall quad (one face, two triangles)
   // between them; then a wall with a hole-like gap (two faces side by side).
