@@ -110,6 +110,26 @@ void BM_ShadowRays_EmbreeOccluded8(benchmark::State& state) {
 }
 BENCHMARK(BM_ShadowRays_EmbreeOccluded8)->Unit(benchmark::kMicrosecond);
 
+// Our rays against the first N shaft candidates (the cost grows with N; Embree's
+// against the whole scene does not): where the two cross over.
+void BM_ShadowRays_OwnAgainstNCandidates(benchmark::State& state) {
+  const ClutterScene& s = clutter();
+  const auto count = std::min<std::size_t>(static_cast<std::size_t>(state.range(0)), s.candidates.size());
+  const std::span<const Triangle> candidates(s.candidates.data(), count);
+  std::size_t blocked = 0;
+  for (auto _ : state)
+    for (std::size_t i = 0; i < s.from.size(); ++i)
+      for (const Triangle& t : candidates)
+        if (segment_hits_triangle(s.from[i], s.to[i], t)) {
+          ++blocked;
+          break;
+        }
+  benchmark::DoNotOptimize(blocked);
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * s.from.size()));
+  state.counters["candidates"] = static_cast<double>(count);
+}
+BENCHMARK(BM_ShadowRays_OwnAgainstNCandidates)->Arg(1)->Arg(4)->Arg(16)->Arg(64)->Unit(benchmark::kMicrosecond);
+
 void BM_ShaftCulling_Bvh(benchmark::State& state) {
   const ClutterScene& s = clutter();
   for (auto _ : state) {

@@ -131,11 +131,19 @@ bool segment_hits_triangle(const dvec3& a, const dvec3& b, const Triangle& t) {
 double visible_fraction(std::span<const Triangle> candidates, const dvec3& r,
                         const EmitterSamples& samples) {
   std::vector<std::uint8_t> blocked(samples.points.size(), 0);
+  // Neighbouring samples tend to be blocked by the same triangle: try the last
+  // blocker first.
+  std::size_t last = 0;
   for (std::size_t i = 0; i < samples.points.size(); ++i) {
     if (samples.weights[i] <= 0.0) continue;
-    for (const Triangle& t : candidates)
-      if (segment_hits_triangle(r, samples.points[i], t)) {
+    if (!candidates.empty() && segment_hits_triangle(r, samples.points[i], candidates[last])) {
+      blocked[i] = 1;
+      continue;
+    }
+    for (std::size_t t = 0; t < candidates.size(); ++t)
+      if (t != last && segment_hits_triangle(r, samples.points[i], candidates[t])) {
         blocked[i] = 1;
+        last = t;
         break;
       }
   }
