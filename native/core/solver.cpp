@@ -17,8 +17,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // Threshold range of each oracle over quality (0, 1], log-spaced. Measured on
-// the bundled scenes so that the ends mean "barely refined" and "as fine as
-// the minimum element size allows" (see README, "Quality").
+// a 4 x 4 x 3 m room with a ceiling light and a box (tests/native), so that the
+// three oracles make similar element counts at the same quality (about 4,000 at
+// 0.5) and 0.1 barely refines; see bench/ for the sweeps.
 struct ThresholdRange {
   double coarse, fine;
 };
@@ -26,8 +27,8 @@ struct ThresholdRange {
 ThresholdRange threshold_range(Oracle oracle) {
   switch (oracle) {
     case Oracle::Standard: return {1e-2, 1e-7};
-    case Oracle::Perceptual: return {1.0, 1e-4};
-    case Oracle::Gradient: return {1e-1, 1e-6};
+    case Oracle::Perceptual: return {1.0, 4e-3};
+    case Oracle::Gradient: return {1e-1, 2.5e-4};
   }
   return {1.0, 1e-4};
 }

@@ -271,7 +271,7 @@ void bind_solver(py::module_& m) {
         py::arg("time_budget") = py::none(), py::arg("visibility") = "exact", py::arg("rays") = 16,
         py::arg("bounces") = py::none(), py::arg("threads") = py::none(),
         py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
-        py::arg("min_element_area") = 1e-6,
+        py::arg("min_element_area") = 1e-5,
         "Hierarchical radiosity. oracle: 'standard' | 'perceptual' | 'gradient'; quality in\n"
         "[0, 1] (0: no refinement); max_elements, time_budget (s): budgets; visibility:\n"
         "'exact' | 'sampled' (rays per sample); bounces: fixed iteration count instead of\n"
