@@ -10,13 +10,21 @@ namespace {
 
 double cross2(const dvec2& a, const dvec2& b) { return a.x * b.y - a.y * b.x; }
 
-// Area of the convex hull of 2D points (Andrew's monotone chain).
-double convex_hull_area(std::vector<dvec2> p) {
-  if (p.size() < 3) return 0.0;
+using Polygon2 = std::vector<dvec2>;
+
+double signed_area(const Polygon2& p) {
+  double a = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) a += cross2(p[i], p[(i + 1) % p.size()]);
+  return 0.5 * a;
+}
+
+// Convex hull of 2D points, counter-clockwise (Andrew's monotone chain).
+Polygon2 convex_hull(Polygon2 p) {
+  if (p.size() < 3) return {};
   std::sort(p.begin(), p.end(), [](const dvec2& a, const dvec2& b) {
     return a.x < b.x || (a.x == b.x && a.y < b.y);
   });
-  std::vector<dvec2> hull(2 * p.size());
+  Polygon2 hull(2 * p.size());
   std::size_t k = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
     while (k >= 2 && cross2(hull[k - 1] - hull[k - 2], p[i] - hull[k - 2]) <= 0.0) --k;
@@ -26,64 +34,57 @@ double convex_hull_area(std::vector<dvec2> p) {
     while (k >= t && cross2(hull[k - 1] - hull[k - 2], p[i] - hull[k - 2]) <= 0.0) --k;
     hull[k++] = p[i];
   }
-  double area = 0.0;
-  for (std::size_t i = 0; i + 1 < k; ++i) area += cross2(hull[i], hull[i + 1]);
-  return 0.5 * area;
+  hull.resize(k - 1);  // the last point repeats the first
+  return hull;
 }
 
-// A face can prove "hidden" on its own if its triangles are coplanar and their
-// union is convex (its area equals that of the hull of its vertices).
-bool is_planar_convex(const std::vector<Triangle>& triangles, const std::vector<std::uint32_t>& tris) {
-  if (tris.empty()) return false;
-  const Triangle& t0 = triangles[tris[0]];
-  dvec3 normal = glm::cross(t0.v[1] - t0.v[0], t0.v[2] - t0.v[0]);
-  const double len = glm::length(normal);
-  if (!(len > 0.0)) return false;
-  normal /= len;
-  double size = 0.0, area = 0.0;
-  for (std::uint32_t t : tris)
-    for (const dvec3& v : triangles[t].v) size = std::max(size, glm::length(v - t0.v[0]));
-  const dvec3 e1 = glm::normalize(t0.v[1] - t0.v[0]);
-  const dvec3 e2 = glm::cross(normal, e1);
-  std::vector<dvec2> points;
-  for (std::uint32_t t : tris) {
-    const Triangle& tri = triangles[t];
-    for (const dvec3& v : tri.v) {
-      if (std::abs(glm::dot(normal, v - t0.v[0])) > 1e-9 * size) return false;
-      points.push_back({glm::dot(v - t0.v[0], e1), glm::dot(v - t0.v[0], e2)});
+// Part of convex `in` where w . q + c has sign `side` (Sutherland-Hodgman).
+Polygon2 clip_half_plane(const Polygon2& in, const dvec2& w, double c, double side) {
+  Polygon2 out;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const dvec2& a = in[i];
+    const dvec2& b = in[(i + 1) % in.size()];
+    const double da = side * (glm::dot(w, a) + c), db = side * (glm::dot(w, b) + c);
+    if (da >= 0.0) out.push_back(a);
+    if ((da >= 0.0) != (db >= 0.0)) out.push_back(a + (da / (da - db)) * (b - a));
+  }
+  return out;
+}
+
+// Is convex `region` covered by the union of `triangles` (counter-clockwise)?
+// Subtracts them one by one by successive half-planes; leftovers smaller than
+// `tiny` (slivers along shared edges) count as covered.
+bool covered(const Polygon2& region, const std::vector<Polygon2>& triangles, double tiny) {
+  std::vector<Polygon2> pieces{region}, next;
+  for (const Polygon2& t : triangles) {
+    next.clear();
+    for (const Polygon2& piece : pieces) {
+      Polygon2 rest = piece;
+      for (std::size_t i = 0; i < 3 && !rest.empty(); ++i) {
+        const dvec2 d = t[(i + 1) % 3] - t[i];
+        const dvec2 w(-d.y, d.x);
+        const double c = -glm::dot(w, t[i]);
+        Polygon2 outside = clip_half_plane(rest, w, c, -1.0);
+        if (outside.size() >= 3 && signed_area(outside) > tiny) next.push_back(std::move(outside));
+        rest = clip_half_plane(rest, w, c, +1.0);
+        if (rest.size() < 3 || signed_area(rest) <= tiny) rest.clear();
+      }
     }
-    area += 0.5 * glm::length(glm::cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]));
+    std::swap(pieces, next);
+    if (pieces.empty()) return true;
   }
-  const double hull = convex_hull_area(points);
-  return area > 0.0 && std::abs(hull - area) <= 1e-9 * area;
+  return false;
 }
 
-// Point inside triangle (inclusive, relative tolerance), the point on its plane.
-bool inside_triangle(const Triangle& t, const dvec3& p) {
-  const dvec3 n = glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0]);
-  const double nn = glm::dot(n, n);
-  if (!(nn > 0.0)) return false;
-  for (int i = 0; i < 3; ++i) {
-    const dvec3& a = t.v[i];
-    const dvec3& b = t.v[(i + 1) % 3];
-    if (glm::dot(glm::cross(b - a, p - a), n) < -1e-12 * nn) return false;
-  }
-  return true;
-}
-
-// Every segment from a receiver corner to an emitter corner crosses the plane of
-// `tris` (the two elements strictly on either side) inside one of `tris`. The
-// crossings span the shaft's cross-section on that plane (the hull of the
-// corners meets the plane in the hull of these points), so when the triangles'
-// union is convex, every segment between the elements is blocked.
-bool blocks_shaft(const std::vector<Triangle>& triangles, std::span<const std::uint32_t> tris,
-                  std::span<const dvec3> receiver, std::span<const dvec3> emitter, double tol) {
-  const Triangle& t0 = triangles[tris[0]];
-  dvec3 normal = glm::cross(t0.v[1] - t0.v[0], t0.v[2] - t0.v[0]);
-  const double len = glm::length(normal);
-  if (!(len > 0.0)) return false;
-  normal /= len;
-  const double offset = glm::dot(normal, t0.v[0]);
+// Do the candidates lying in one plane block every segment between the two
+// elements? They must separate the elements (all receiver corners strictly on
+// one side of the plane, all emitter corners on the other), and cover the
+// shaft's cross-section on the plane: the convex hull of the points where the
+// corner-to-corner segments cross it (the hull of the corners meets the plane in
+// exactly that hull).
+bool plane_blocks_shaft(const OccluderScene& scene, const std::vector<std::uint32_t>& group,
+                        const dvec3& normal, double offset, std::span<const dvec3> receiver,
+                        std::span<const dvec3> emitter, double tol) {
   double rmin = 1e300, rmax = -1e300, emin = 1e300, emax = -1e300;
   for (const dvec3& p : receiver) {
     const double d = glm::dot(normal, p) - offset;
@@ -93,41 +94,65 @@ bool blocks_shaft(const std::vector<Triangle>& triangles, std::span<const std::u
     const double d = glm::dot(normal, p) - offset;
     emin = std::min(emin, d), emax = std::max(emax, d);
   }
-  const bool separates = (rmax < -tol && emin > tol) || (rmin > tol && emax < -tol);
-  if (!separates) return false;
+  if (!((rmax < -tol && emin > tol) || (rmin > tol && emax < -tol))) return false;
+  // A frame of the plane.
+  const dvec3 helper = std::abs(normal.x) < 0.6 ? dvec3(1, 0, 0) : dvec3(0, 1, 0);
+  const dvec3 e1 = glm::normalize(glm::cross(normal, helper));
+  const dvec3 e2 = glm::cross(normal, e1);
+  const auto to_plane = [&](const dvec3& p) { return dvec2(glm::dot(p, e1), glm::dot(p, e2)); };
+  Polygon2 crossings;
   for (const dvec3& a : receiver) {
     const double da = glm::dot(normal, a) - offset;
     for (const dvec3& b : emitter) {
       const double db = glm::dot(normal, b) - offset;
-      const dvec3 p = a + (da / (da - db)) * (b - a);
-      bool covered = false;
-      for (std::uint32_t t : tris)
-        if (inside_triangle(triangles[t], p)) {
-          covered = true;
-          break;
-        }
-      if (!covered) return false;
+      crossings.push_back(to_plane(a + (da / (da - db)) * (b - a)));
     }
   }
-  return true;
+  const Polygon2 region = convex_hull(crossings);
+  const double area = signed_area(region);
+  if (region.size() < 3 || !(area > 0.0)) return false;
+  std::vector<Polygon2> triangles;
+  for (std::uint32_t t : group) {
+    Polygon2 tri{to_plane(scene.triangles[t].v[0]), to_plane(scene.triangles[t].v[1]),
+                 to_plane(scene.triangles[t].v[2])};
+    const double a = signed_area(tri);
+    if (a == 0.0) continue;
+    if (a < 0.0) std::swap(tri[1], tri[2]);
+    triangles.push_back(tri);
+  }
+  return covered(region, triangles, 1e-12 * area);
 }
 
+// Clear, hidden or partial. "Hidden" is proved by one plane's candidates
+// together (a wall made of several faces counts), never guessed.
 ShaftVisibility classify(const OccluderScene& scene, const std::vector<std::uint32_t>& candidates,
                          std::span<const dvec3> receiver, std::span<const dvec3> emitter,
                          double tol) {
   if (candidates.empty()) return ShaftVisibility::clear;
-  std::vector<std::uint32_t> tested_faces;
-  for (std::uint32_t t : candidates) {
-    const std::uint32_t f = scene.face[t];
-    if (scene.face_planar_convex[f]) {
-      if (std::find(tested_faces.begin(), tested_faces.end(), f) != tested_faces.end()) continue;
-      tested_faces.push_back(f);
-      if (blocks_shaft(scene.triangles, scene.face_triangles[f], receiver, emitter, tol))
-        return ShaftVisibility::hidden;
-    } else if (blocks_shaft(scene.triangles, std::span<const std::uint32_t>(&t, 1), receiver,
-                            emitter, tol)) {
-      return ShaftVisibility::hidden;
+  if (candidates.size() > 512) return ShaftVisibility::partial;  // not worth the search
+  std::vector<bool> grouped(candidates.size(), false);
+  std::vector<std::uint32_t> group;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (grouped[i]) continue;
+    const Triangle& t = scene.triangles[candidates[i]];
+    dvec3 normal = glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0]);
+    const double len = glm::length(normal);
+    if (!(len > 0.0)) continue;
+    normal /= len;
+    const double offset = glm::dot(normal, t.v[0]);
+    group.clear();
+    for (std::size_t j = i; j < candidates.size(); ++j) {
+      const Triangle& u = scene.triangles[candidates[j]];
+      const bool coplanar = std::abs(glm::dot(normal, u.v[0]) - offset) <= tol &&
+                            std::abs(glm::dot(normal, u.v[1]) - offset) <= tol &&
+                            std::abs(glm::dot(normal, u.v[2]) - offset) <= tol;
+      if (coplanar) {
+        grouped[j] = true;
+        group.push_back(candidates[j]);
+      }
     }
+    if (plane_blocks_shaft(scene, group, normal, offset, receiver, emitter, tol))
+      return ShaftVisibility::hidden;
   }
   return ShaftVisibility::partial;
 }
@@ -155,13 +180,6 @@ OccluderScene make_occluder_scene(std::vector<Triangle> triangles, std::vector<s
     std::iota(face.begin(), face.end(), 0u);
   }
   scene.face = std::move(face);
-  std::uint32_t faces = 0;
-  for (std::uint32_t f : scene.face) faces = std::max(faces, f + 1);
-  scene.face_triangles.resize(faces);
-  for (std::uint32_t t = 0; t < scene.face.size(); ++t) scene.face_triangles[scene.face[t]].push_back(t);
-  scene.face_planar_convex.resize(faces);
-  for (std::uint32_t f = 0; f < faces; ++f)
-    scene.face_planar_convex[f] = is_planar_convex(scene.triangles, scene.face_triangles[f]);
   scene.bvh = build_scene_bvh(scene.triangles);
   return scene;
 }

@@ -9,9 +9,10 @@
 // link. Candidates come from the scene's BVH (scene_bvh.h), minus the two
 // elements' own faces.
 //
-// Fast answers: `clear` when no candidate is left; `hidden` when one candidate
-// face (planar and convex) separates the two elements and covers the whole
-// cross-section of the shaft on its plane, so that every segment crosses it.
+// Fast answers: `clear` when no candidate is left; `hidden` when the candidates
+// lying in one plane (one face, or a wall made of many) separate the two
+// elements and together cover the whole cross-section of the shaft on that
+// plane, so that every segment between the elements crosses them.
 #pragma once
 
 #include <cstdint>
@@ -31,9 +32,7 @@ inline constexpr std::uint32_t kNoFace = std::numeric_limits<std::uint32_t>::max
 // belongs to (links exclude their own faces), and the BVH over them.
 struct OccluderScene {
   std::vector<Triangle> triangles;
-  std::vector<std::uint32_t> face;      // per triangle
-  std::vector<bool> face_planar_convex;  // per face: may prove "hidden" alone
-  std::vector<std::vector<std::uint32_t>> face_triangles;
+  std::vector<std::uint32_t> face;  // per triangle
   SceneBvh bvh;
 };
 
