@@ -3,6 +3,7 @@
 // the code under test: MATH.md values, Monte Carlo integration with a ray caster
 // written here, central finite differences, brute force.
 #include <gtest/gtest.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -555,6 +556,26 @@ TEST(VisiblePolygon, ScaleInvariance) {
     const FormFactorGradient fg = visible_form_factor_gradient(r * scale, n, e, o);
     EXPECT_NEAR(fg.value, base.value, 1e-13 * base.value) << scale;
     EXPECT_NEAR(glm::length(fg.gradient * scale - base.gradient), 0.0, 1e-11) << scale;
+  }
+}
+
+TEST(VisiblePolygon, SameResultsFromManyThreads) {
+  // Per-thread workspaces: evaluations in parallel give the serial answers, bit for bit.
+  std::mt19937_64 rng(47);
+  std::vector<Configuration> configurations;
+  for (int i = 0; i < 256; ++i) configurations.push_back(random_configuration(rng, 1 + i % 8, 0.3));
+  std::vector<FormFactorGradient> serial(configurations.size()), parallel(configurations.size());
+  for (std::size_t i = 0; i < configurations.size(); ++i) {
+    const Configuration& c = configurations[i];
+    serial[i] = visible_form_factor_gradient(c.r, c.n, c.emitter, c.occluders);
+  }
+  tbb::parallel_for(std::size_t(0), configurations.size(), [&](std::size_t i) {
+    const Configuration& c = configurations[i];
+    parallel[i] = visible_form_factor_gradient(c.r, c.n, c.emitter, c.occluders);
+  });
+  for (std::size_t i = 0; i < configurations.size(); ++i) {
+    EXPECT_EQ(serial[i].value, parallel[i].value) << i;
+    EXPECT_EQ(serial[i].gradient, parallel[i].gradient) << i;
   }
 }
 
