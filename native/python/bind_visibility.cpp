@@ -61,6 +61,14 @@ std::vector<Triangle> read_triangles(const py::handle& object, const std::string
   return triangles;
 }
 
+py::array_t<double> to_numpy(const std::vector<dvec3>& points) {
+  py::array_t<double> out({static_cast<py::ssize_t>(points.size()), py::ssize_t{3}});
+  auto w = out.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < points.size(); ++i)
+    for (py::ssize_t k = 0; k < 3; ++k) w(static_cast<py::ssize_t>(i), k) = points[i][static_cast<int>(k)];
+  return out;
+}
+
 }  // namespace
 
 void bind_visibility(py::module_& m) {
@@ -99,6 +107,43 @@ void bind_visibility(py::module_& m) {
       "mode='exact': the visible polygon (Section 4.3) and its exact gradient.\n"
       "mode='sampled': `rays` stratified shadow rays (Embree) give the visible\n"
       "fraction; F and the unoccluded gradient are scaled by it.");
+  m.def(
+      "visible_polygon",
+      [](const py::handle& point, const py::handle& normal, const py::handle& emitter,
+         const py::handle& occluders) {
+        const dvec3 r = read_vec3(point, "point");
+        const dvec3 n = read_unit_vec3(normal, "normal");
+        const std::vector<dvec3> polygon = read_polygon(emitter, "emitter");
+        require_planar_convex(polygon, "emitter");
+        const std::vector<Triangle> triangles = read_triangles(occluders, "occluders");
+        VisiblePolygon visible;
+        {
+          py::gil_scoped_release release;
+          visible = radiosity::visible_polygon(r, n, polygon, triangles);
+        }
+        py::list pieces;
+        for (const VisiblePiece& piece : visible.pieces) {
+          std::vector<dvec3> positions, anchors;
+          py::list kinds;
+          for (const ContourVertex& v : piece) {
+            positions.push_back(v.position);
+            anchors.push_back(v.anchor);
+            kinds.append(v.apparent ? "apparent" : v.horizon ? "horizon" : "intrinsic");
+          }
+          py::dict d;
+          d["positions"] = to_numpy(positions);
+          d["anchors"] = to_numpy(anchors);
+          d["kinds"] = kinds;
+          pieces.append(d);
+        }
+        return py::make_tuple(pieces, visible.occluded);
+      },
+      py::arg("point"), py::arg("normal"), py::arg("emitter"), py::arg("occluders"),
+      "The visible part of `emitter` from `point` (Section 4.3, Figure 19) as\n"
+      "(pieces, occluded): convex pieces, each a dict with 'positions' (k, 3) on the\n"
+      "emitter plane, 'anchors' (k, 3) (the 3D point an intrinsic vertex stands\n"
+      "for: an occluder vertex, not its projection) and 'kinds' ('intrinsic',\n"
+      "'apparent' or 'horizon'); `occluded` says whether an occluder mattered.");
 }
 
 }  // namespace radiosity::python

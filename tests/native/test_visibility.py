@@ -56,6 +56,29 @@ class ExactMode(unittest.TestCase):
         self.assertTrue(np.all(g == 0))
 
 
+class VisiblePolygonPieces(unittest.TestCase):
+    def test_pieces_integrate_to_the_visible_form_factor(self):
+        pieces, occluded = rad.visible_polygon(POINT, NORMAL, EMITTER, OCCLUDER)
+        self.assertTrue(occluded)
+        total = sum(rad.form_factor(POINT, NORMAL, p["positions"]) for p in pieces)
+        f, _ = rad.visible_form_factor(POINT, NORMAL, EMITTER, OCCLUDER)
+        self.assertAlmostEqual(total, f, places=14)
+        kinds = [k for p in pieces for k in p["kinds"]]
+        self.assertIn("apparent", kinds)
+        # The occluder vertex seen inside the emitter is anchored at its 3D position.
+        anchors = np.concatenate([p["anchors"] for p in pieces])
+        self.assertTrue(np.any(np.all(np.abs(anchors - OCCLUDER[0, 0]) < 1e-12, axis=1)))
+        for p in pieces:
+            self.assertEqual(p["positions"].shape, p["anchors"].shape)
+            np.testing.assert_allclose(p["positions"][:, 2], 2.0, atol=1e-12)
+
+    def test_unoccluded_is_the_emitter(self):
+        pieces, occluded = rad.visible_polygon(POINT, NORMAL, EMITTER, [])
+        self.assertFalse(occluded)
+        self.assertEqual(len(pieces), 1)
+        np.testing.assert_allclose(pieces[0]["positions"], EMITTER, atol=1e-15)
+
+
 class SampledMode(unittest.TestCase):
     def test_converges_to_exact(self):
         exact, _ = rad.visible_form_factor(POINT, NORMAL, EMITTER, OCCLUDER)
