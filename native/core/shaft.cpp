@@ -124,34 +124,79 @@ bool plane_blocks_shaft(const OccluderScene& scene, const std::vector<std::uint3
 }
 
 // Clear, hidden or partial. "Hidden" is proved by one plane's candidates
-// together (a wall made of several faces counts), never guessed.
+// together (a wall made of several faces counts), never guessed; a missed proof
+// only costs time (the link is then evaluated as partial).
 ShaftVisibility classify(const OccluderScene& scene, const std::vector<std::uint32_t>& candidates,
                          std::span<const dvec3> receiver, std::span<const dvec3> emitter,
                          double tol) {
   if (candidates.empty()) return ShaftVisibility::clear;
-  if (candidates.size() > 512) return ShaftVisibility::partial;  // not worth the search
-  std::vector<bool> grouped(candidates.size(), false);
-  std::vector<std::uint32_t> group;
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
-    if (grouped[i]) continue;
-    const Triangle& t = scene.triangles[candidates[i]];
-    dvec3 normal = glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0]);
+  if (candidates.size() > 4096) return ShaftVisibility::partial;  // not worth the search
+  // Candidates by plane: unit normal with a canonical sign, and offset. Sorting
+  // puts coplanar triangles next to each other.
+  struct PlaneOf {
+    dvec3 normal;
+    double offset;
+    std::uint32_t triangle;
+  };
+  std::vector<PlaneOf> planes;
+  planes.reserve(candidates.size());
+  for (std::uint32_t t : candidates) {
+    const Triangle& tri = scene.triangles[t];
+    dvec3 normal = glm::cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]);
     const double len = glm::length(normal);
     if (!(len > 0.0)) continue;
     normal /= len;
-    const double offset = glm::dot(normal, t.v[0]);
+    const double sign = normal.x != 0.0 ? normal.x : normal.y != 0.0 ? normal.y : normal.z;
+    if (sign < 0.0) normal = -normal;
+    planes.push_back({normal, glm::dot(normal, tri.v[0]), t});
+  }
+  std::sort(planes.begin(), planes.end(), [](const PlaneOf& a, const PlaneOf& b) {
+    if (a.normal.x != b.normal.x) return a.normal.x < b.normal.x;
+    if (a.normal.y != b.normal.y) return a.normal.y < b.normal.y;
+    if (a.normal.z != b.normal.z) return a.normal.z < b.normal.z;
+    return a.offset < b.offset;
+  });
+  std::vector<std::uint32_t> group;
+  for (std::size_t i = 0; i < planes.size();) {
+    const dvec3 normal = planes[i].normal;
+    const double offset = planes[i].offset;
+    // The plane must separate the two elements, else nothing in it blocks all.
+    double rmin = 1e300, rmax = -1e300, emin = 1e300, emax = -1e300;
+    for (const dvec3& p : receiver) {
+      const double d = glm::dot(normal, p) - offset;
+      rmin = std::min(rmin, d), rmax = std::max(rmax, d);
+    }
+    for (const dvec3& p : emitter) {
+      const double d = glm::dot(normal, p) - offset;
+      emin = std::min(emin, d), emax = std::max(emax, d);
+    }
+    const bool separates = (rmax < -tol && emin > tol) || (rmin > tol && emax < -tol);
     group.clear();
-    for (std::size_t j = i; j < candidates.size(); ++j) {
-      const Triangle& u = scene.triangles[candidates[j]];
+    Aabb box;
+    std::size_t j = i;
+    for (; j < planes.size(); ++j) {
+      const Triangle& u = scene.triangles[planes[j].triangle];
       const bool coplanar = std::abs(glm::dot(normal, u.v[0]) - offset) <= tol &&
                             std::abs(glm::dot(normal, u.v[1]) - offset) <= tol &&
                             std::abs(glm::dot(normal, u.v[2]) - offset) <= tol;
-      if (coplanar) {
-        grouped[j] = true;
-        group.push_back(candidates[j]);
+      if (!coplanar) break;
+      group.push_back(planes[j].triangle);
+      for (const dvec3& v : u.v) box.grow(v);
+    }
+    i = std::max(j, i + 1);
+    if (!separates) continue;
+    // Cheap necessary condition: the group's box holds every crossing point.
+    bool inside_box = true;
+    for (const dvec3& a : receiver) {
+      const double da = glm::dot(normal, a) - offset;
+      for (const dvec3& b : emitter) {
+        const double db = glm::dot(normal, b) - offset;
+        const dvec3 x = a + (da / (da - db)) * (b - a);
+        inside_box = inside_box && glm::all(glm::greaterThanEqual(x, box.lo - tol)) &&
+                     glm::all(glm::lessThanEqual(x, box.hi + tol));
       }
     }
-    if (plane_blocks_shaft(scene, group, normal, offset, receiver, emitter, tol))
+    if (inside_box && plane_blocks_shaft(scene, group, normal, offset, receiver, emitter, tol))
       return ShaftVisibility::hidden;
   }
   return ShaftVisibility::partial;
