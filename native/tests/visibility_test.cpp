@@ -559,6 +559,30 @@ TEST(VisiblePolygon, ScaleInvariance) {
   }
 }
 
+TEST(VisiblePolygon, TranslationInvariance) {
+  // Far from the origin only the coordinates' own rounding remains (1e-16 of
+  // the offset): an offset of 1e6 costs about 1e-10.
+  const dvec3 r(0.03, -0.02, 0.0);
+  const dvec3 n = glm::normalize(dvec3(0.1, -0.2, 1.0));
+  const Polygon emitter = math_emitter();
+  const std::vector<Triangle> occluders{
+      math_occluder(),
+      Triangle{{dvec3(-0.3, -0.2, 1.0), dvec3(0.0, -0.5, 1.0), dvec3(0.25, 0.0, 1.0)}},
+      Triangle{{dvec3(-0.5, 0.5, 2.0), dvec3(0.0, 0.0, 1.5), dvec3(-0.5, -0.5, 2.0)}}};
+  const FormFactorGradient base = visible_form_factor_gradient(r, n, emitter, occluders);
+  for (const double offset : {1e2, 1e4, 1e6}) {
+    const dvec3 t(offset, -offset, 0.5 * offset);
+    Polygon e = emitter;
+    for (dvec3& v : e) v += t;
+    std::vector<Triangle> o = occluders;
+    for (Triangle& tri : o)
+      for (dvec3& v : tri.v) v += t;
+    const FormFactorGradient fg = visible_form_factor_gradient(r + t, n, e, o);
+    EXPECT_NEAR(fg.value, base.value, 1e-15 * offset * base.value + 1e-16) << offset;
+    EXPECT_NEAR(glm::length(fg.gradient - base.gradient), 0.0, 1e-14 * offset) << offset;
+  }
+}
+
 TEST(VisiblePolygon, SameResultsFromManyThreads) {
   // Per-thread workspaces: evaluations in parallel give the serial answers, bit for bit.
   std::mt19937_64 rng(47);
