@@ -106,7 +106,7 @@ Hierarchy::Hierarchy(const Scene& scene) : scene_(&scene) {
       e.patch = p;
       e.side = static_cast<std::uint8_t>(side);
       e.corner_count = patch.corner_count;
-      e.area = static_cast<float>(patch.area);
+      e.area = patch.area;
       // Each side has its own vertices (its own radiance); the back side winds
       // the other way so its corners are counter-clockwise about its normal.
       for (int k = 0; k < patch.corner_count; ++k) {

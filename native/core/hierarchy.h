@@ -28,9 +28,9 @@ struct Element {
   std::uint8_t corner_count = 0;  // 3 or 4; samples = corner_count + 1 (centre last)
   std::uint8_t depth = 0;
   std::uint8_t has_links = 0;     // a link ends on this element or an ancestor
-  float area = 0.0f;
+  double area = 0.0;
   std::array<Rgb, kMaxSamples> gathered{};  // sum of F L over this element's own links
-  Rgb radiance{0.0f};                       // area average, L_e + rho H
+  Rgb radiance{0.0};                       // area average, L_e + rho H
 
   int sample_count() const { return corner_count + 1; }
   bool is_leaf() const { return first_child == kNone; }

@@ -21,7 +21,9 @@ struct Link {
   std::int32_t receiver = kNone;
   std::int32_t emitter = kNone;
   std::array<float, kMaxSamples> form_factor{};  // per receiver sample
-  float oracle = 0.0f;  // geometric part of the refinement criterion
+  // Geometric part of the refinement criterion over the oracle's geometric
+  // scale (oracle_geometric_scale): dimensionless.
+  float oracle = 0.0f;
 };
 
 // CPU seconds spent in each part of link evaluation (summed over threads).
@@ -52,6 +54,7 @@ struct LinkEvaluator {
   VisibilityMode visibility = VisibilityMode::Exact;
   int rays = 16;
   Oracle oracle = Oracle::Standard;
+  double geometric_scale = 1.0;  // oracle_geometric_scale() of the scene
 
   // Fills `link.form_factor` and `link.oracle`; false when the emitter is not
   // seen from any sample (facing away, coplanar or fully hidden).

@@ -88,6 +88,10 @@ double oracle_geometry(Oracle oracle, const LinkSamples& s) {
   return 0.0;
 }
 
+double oracle_geometric_scale(Oracle oracle, double total_area) {
+  return oracle_scale(oracle, 1.0, total_area);
+}
+
 double oracle_scale(Oracle oracle, double reference_radiance, double total_area) {
   switch (oracle) {
     case Oracle::Standard: return reference_radiance * total_area;

@@ -50,7 +50,9 @@ double perceptual_criterion(std::span<const dvec3> position, std::span<const dou
 
 // The oracle's scale in a scene, so thresholds are relative (DESIGN s3): with
 // reference radiance L_ref and total area A, Standard divides by L_ref A,
-// Perceptual by L_ref, Gradient by L_ref sqrt(A).
+// Perceptual by L_ref, Gradient by L_ref sqrt(A). The geometric part (A, 1,
+// sqrt(A)) is applied when a link is made, so links store a dimensionless value.
 double oracle_scale(Oracle oracle, double reference_radiance, double total_area);
+double oracle_geometric_scale(Oracle oracle, double total_area);
 
 }  // namespace radiosity

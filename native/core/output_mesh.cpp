@@ -60,7 +60,8 @@ OutputMesh make_output_mesh(const Hierarchy& h,
     return remap[v];
   };
   std::vector<std::uint32_t> polygon;
-  for (const Element& e : elements) {
+  for (size_t i = 0; i < elements.size(); ++i) {
+    const Element& e = elements[i];
     if (!e.is_leaf() || !shown(e.patch, e.side)) continue;
     polygon.clear();
     for (int k = 0; k < e.corner_count; ++k) {
@@ -73,6 +74,10 @@ OutputMesh make_output_mesh(const Hierarchy& h,
     mesh.face_sizes.push_back(static_cast<std::int32_t>(polygon.size()));
     mesh.source_face.push_back(static_cast<std::int32_t>(h.patch_of(e).face));
     mesh.source_side.push_back(e.side);
+    const Rgb mean = Interpolant::average(e.corner_count, leaf_irradiance[i]);
+    mesh.irradiance.insert(mesh.irradiance.end(), {static_cast<float>(mean.x),
+                                                   static_cast<float>(mean.y),
+                                                   static_cast<float>(mean.z)});
   }
   return mesh;
 }

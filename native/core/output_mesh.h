@@ -20,6 +20,9 @@ struct OutputMesh {
   std::vector<float> radiance;            // 3 per vertex
   std::vector<std::int32_t> source_face;  // per polygon: the input face
   std::vector<std::uint8_t> source_side;  // per polygon: 0 front, 1 back
+  // Per polygon: area average of the gathered H (irradiance / pi) over the
+  // element, as the solver integrates it: absorbed power is pi (1 - rho) H A.
+  std::vector<float> irradiance;          // 3 per polygon
 
   std::size_t vertex_count() const { return positions.size() / 3; }
   std::size_t polygon_count() const { return face_sizes.size(); }

@@ -33,8 +33,8 @@ struct Patch {
   std::uint32_t face = 0;          // index of the input face
   dvec3 normal{0.0};               // front side
   double area = 0.0;
-  Rgb reflectance{0.0f};
-  Rgb emission{0.0f};
+  Rgb reflectance{0.0};
+  Rgb emission{0.0};
 };
 
 struct SkippedFace {

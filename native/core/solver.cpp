@@ -46,8 +46,9 @@ class Solver {
         start_(Clock::now()),
         hierarchy_(scene),
         occluders_(make_scene_occluders(scene, options.visibility)),
-        evaluator_{hierarchy_, occluders_, options.visibility, options.rays, options.oracle},
-        scale_(oracle_scale(options.oracle, scene.reference_radiance(), scene.total_area)),
+        evaluator_{hierarchy_, occluders_, options.visibility, options.rays, options.oracle,
+                   oracle_geometric_scale(options.oracle, scene.total_area)},
+        reference_radiance_(scene.reference_radiance()),
         min_area_(options.min_element_area * scene.total_area) {}
 
   SolveResult run();
@@ -81,7 +82,7 @@ class Solver {
   Hierarchy hierarchy_;
   SceneOccluders occluders_;
   LinkEvaluator evaluator_;
-  const double scale_;
+  const double reference_radiance_;
   const double min_area_;
   std::vector<Link> links_;
   SolveResult result_;     // the last complete pass
@@ -193,7 +194,7 @@ Split Solver::choose_split(const Link& link, double threshold) const {
   const Element& p = hierarchy_.element(link.receiver);
   const Element& q = hierarchy_.element(link.emitter);
   const double brightness = luminance(hierarchy_.reflectance(p) * q.radiance);
-  if (!(brightness * link.oracle / scale_ > threshold)) return Split::None;
+  if (!(brightness / reference_radiance_ * link.oracle > threshold)) return Split::None;
   const bool receiver_first = p.area >= q.area;
   const std::int32_t first = receiver_first ? link.receiver : link.emitter;
   const std::int32_t second = receiver_first ? link.emitter : link.receiver;
@@ -252,7 +253,7 @@ bool Solver::refine(double threshold) {
 // H_p[s] = sum over p's links of F_s L_q, per receiver in link order.
 void Solver::gather() {
   auto& elements = hierarchy_.elements();
-  for (Element& e : elements) e.gathered.fill(Rgb(0.0f));
+  for (Element& e : elements) e.gathered.fill(Rgb(0.0));
   // Group links by receiver (counting sort keeps link order within a receiver).
   std::vector<std::uint32_t> offset(elements.size() + 1, 0);
   for (const Link& l : links_) ++offset[static_cast<size_t>(l.receiver) + 1];

@@ -104,6 +104,7 @@ struct PyResult {
   py::array_t<std::int32_t> face_vertices, face_sizes, source_face;
   py::array_t<float> radiance;
   py::array_t<std::uint8_t> source_side;
+  py::array_t<float> irradiance;
   py::dict stats;
 };
 
@@ -148,6 +149,7 @@ PyResult to_python(SolveResult&& r) {
   out.face_sizes = hand_over(std::move(m.face_sizes), {polygons});
   out.source_face = hand_over(std::move(m.source_face), {polygons});
   out.source_side = hand_over(std::move(m.source_side), {polygons});
+  out.irradiance = hand_over(std::move(m.irradiance), {polygons, 3});
   out.stats = stats_dict(r.stats);
   return out;
 }
@@ -264,6 +266,8 @@ void bind_solver(py::module_& m) {
       .def_readonly("radiance", &PyResult::radiance, "(V, 3) float32 radiance per vertex")
       .def_readonly("source_face", &PyResult::source_face, "(P,) input face of each polygon")
       .def_readonly("source_side", &PyResult::source_side, "(P,) 0 front, 1 back")
+      .def_readonly("irradiance", &PyResult::irradiance,
+                    "(P, 3) float32 area-average gathered radiance H per polygon (irradiance / pi)")
       .def_readonly("stats", &PyResult::stats, "statistics of the solve (dict)");
 
   m.def("solve", &py_solve, py::arg("scene"), py::arg("oracle") = "perceptual",

@@ -52,10 +52,11 @@ class SceneBuilder:
 
 
 def room_with_blocker(light=5.0):
-    """A 4 x 4 x 3 room, a square ceiling light facing down, a box on the floor under it."""
+    """A 4 x 4 x 3 room, a square ceiling light facing down, and a floating 1.2 m
+    square plate at 1 m under it: umbra, penumbra and lit floor, no contact."""
     b = SceneBuilder()
     room = b.box((0, 0, 0), (4, 4, 3), rho=0.6, inward=True)
-    light_face = b.polygon([(1.5, 1.5, 2.99), (1.5, 2.5, 2.99), (2.5, 2.5, 2.99), (2.5, 1.5, 2.99)],
+    light_face = b.polygon([(1.7, 1.7, 2.99), (1.7, 2.3, 2.99), (2.3, 2.3, 2.99), (2.3, 1.7, 2.99)],
                            rho=0.0, emission=light, two_sided=False)
-    blocker = b.box((1.6, 1.6, 0.0), (2.4, 2.4, 0.8), rho=0.5)
-    return b, dict(room=room, light=light_face, blocker=blocker)
+    plate = b.polygon([(1.4, 1.4, 1.0), (2.6, 1.4, 1.0), (2.6, 2.6, 1.0), (1.4, 2.6, 1.0)], rho=0.5)
+    return b, dict(room=room, light=light_face, blocker=[plate])
