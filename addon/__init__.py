@@ -24,7 +24,7 @@ if "bpy" in locals():
     # Re-running register after F8 / "Reload Scripts": pick up edited modules.
     import importlib
 
-    for _name in ("native", "properties", "operators", "ui"):
+    for _name in ("native", "geometry", "export", "bake", "properties", "operators", "ui"):
         if _name in locals():
             importlib.reload(locals()[_name])
 
@@ -38,6 +38,8 @@ classes = (
     properties.RadiosityStats,
     properties.RadiositySettings,
     operators.RADIOSITY_OT_solve,
+    operators.RADIOSITY_OT_toggle_result,
+    operators.RADIOSITY_OT_clear,
     ui.RENDER_PT_radiosity,
 )
 

@@ -2,21 +2,75 @@
 
 `radiosity.solve` is the one entry point for users, scripts and tests. Its
 execute runs the whole solve synchronously (background mode, scripts, tests);
-invoke, from the UI, will later run the same solve on a worker thread with a
-progress bar, so both paths share `_solve`. Every failure becomes a report and
-{'CANCELLED'}, never a traceback, and leaves the scene as it was.
+invoke, from the UI, runs the same solve on a worker thread with a progress
+bar, status text and ESC to cancel (the solver then returns its last complete
+pass, which is baked). Both paths share `_prepare` (export, on the main thread),
+the native solve, and `_finish` (bake, on the main thread): bpy is never touched
+from the worker. Every failure becomes a report and {'CANCELLED'}, never a
+traceback, and leaves the scene as it was.
+
+`radiosity.toggle_result` switches between the solution and the originals;
+`radiosity.clear` removes the solution and restores the originals.
 """
 
 import sys
+import threading
+import time
 import traceback
+from dataclasses import dataclass, field
 
+import bpy
+import numpy as np
 from bpy.types import Operator
 
-from . import native
+from . import bake, export, native
+
+STATUS = {
+    "quality": "Converged",
+    "max_elements": "Element budget reached",
+    "time_budget": "Time budget reached",
+    "cancel": "Cancelled (last complete pass kept)",
+}
 
 
 class SolveError(Exception):
     """A failure the user can act on; its message is reported as is."""
+
+
+@dataclass
+class Job:
+    """What a solve carries from the main thread to the worker and back."""
+    scene_name: str
+    exported: export.ExportedScene
+    native_scene: object
+    options: dict
+    oracle_label: str
+    progress: dict = field(default_factory=dict)
+    result: object = None
+    error: BaseException = None
+    started: float = field(default_factory=time.perf_counter)
+
+
+def native_options(options):
+    """scene.radiosity.solver_options() in the form rad.solve takes (0 = no limit)."""
+    return {
+        "oracle": options["oracle"],
+        "quality": float(options["quality"]),
+        "max_elements": int(options["max_elements"]) or None,
+        "time_budget": float(options["time_budget"]) or None,
+        "visibility": options["visibility"],
+        "rays": int(options["rays"]),
+        "bounces": int(options["bounces"]) or None,
+    }
+
+
+def progress_text(progress):
+    """One line describing a progress dict of the solver."""
+    if not progress:
+        return "Radiosity: starting"
+    return "Radiosity: pass {} of {}, {}, {:,} elements, {:,} links, {:.1f} s".format(
+        progress.get("pass", 0), progress.get("passes", 0), progress.get("phase", ""),
+        progress.get("elements", 0), progress.get("links", 0), progress.get("seconds", 0.0))
 
 
 class RADIOSITY_OT_solve(Operator):
@@ -42,9 +96,69 @@ class RADIOSITY_OT_solve(Operator):
         return self._run(context)
 
     def invoke(self, context, event):
-        # Synchronous for now; the interactive solve (worker thread, progress,
-        # ESC to cancel) replaces this without changing execute.
-        return self._run(context)
+        if bpy.app.background or context.window is None:
+            return self._run(context)
+        try:
+            solver = native.load()
+            job = self._prepare(context, solver)
+        except (native.NativeUnavailable, SolveError) as err:
+            self.report({'ERROR'}, str(err))
+            return {'CANCELLED'}
+        except Exception as err:
+            return self._unexpected(err)
+        self._job = job
+        self._token = solver.CancelToken()
+        self._thread = threading.Thread(target=self._work, args=(solver, job, self._token),
+                                        name="radiosity-solve", daemon=True)
+        wm = context.window_manager
+        self._timer = wm.event_timer_add(0.1, window=context.window)
+        wm.progress_begin(0, 100)
+        wm.modal_handler_add(self)
+        context.workspace.status_text_set(progress_text({}) + "  (Esc to cancel)")
+        self._thread.start()
+        return {'RUNNING_MODAL'}
+
+    def modal(self, context, event):
+        if event.type == 'ESC' and event.value == 'PRESS':
+            self._token.cancel()
+            context.workspace.status_text_set("Radiosity: cancelling, keeping the last complete pass")
+            return {'RUNNING_MODAL'}
+        if event.type == 'TIMER' and event.timer is self._timer:
+            if self._thread.is_alive():
+                progress = dict(self._job.progress)
+                context.window_manager.progress_update(100.0 * float(progress.get("fraction", 0.0)))
+                if not self._token.cancelled:
+                    context.workspace.status_text_set(progress_text(progress) + "  (Esc to cancel)")
+                return {'RUNNING_MODAL'}
+            self._stop_modal(context)
+            return self._conclude(context, self._job)
+        if event.type in {'MIDDLEMOUSE', 'WHEELUPMOUSE', 'WHEELDOWNMOUSE', 'TRACKPADPAN',
+                          'TRACKPADZOOM', 'MOUSEMOVE', 'INBETWEEN_MOUSEMOVE'}:
+            return {'PASS_THROUGH'}  # let the user look around while it solves
+        return {'RUNNING_MODAL'}
+
+    def cancel(self, context):
+        # Blender ends the operator (file closed, window gone): stop the worker.
+        self._token.cancel()
+        self._thread.join()
+        self._stop_modal(context)
+
+    def _stop_modal(self, context):
+        wm = context.window_manager
+        if self._timer is not None:
+            wm.event_timer_remove(self._timer)
+            self._timer = None
+        wm.progress_end()
+        context.workspace.status_text_set(None)
+
+    @staticmethod
+    def _work(solver, job, token):
+        """The worker thread: only the native solve, which releases the GIL."""
+        try:
+            job.result = solver.solve(job.native_scene, progress=job.progress.update,
+                                      cancel=token, **job.options)
+        except BaseException as err:  # reported on the main thread
+            job.error = err
 
     def _run(self, context):
         try:
@@ -53,14 +167,163 @@ class RADIOSITY_OT_solve(Operator):
         except (native.NativeUnavailable, SolveError) as err:
             self.report({'ERROR'}, str(err))
         except Exception as err:
-            # A bug: the traceback goes to the console for whoever fixes it,
-            # the user gets a report.
-            traceback.print_exc(file=sys.stderr)
-            self.report({'ERROR'}, "Radiosity solve failed unexpectedly: %s: %s"
-                        % (type(err).__name__, err))
+            return self._unexpected(err)
+        return {'CANCELLED'}
+
+    def _unexpected(self, err):
+        # A bug: the traceback goes to the console for whoever fixes it, the
+        # user gets a report.
+        traceback.print_exc(file=sys.stderr)
+        self.report({'ERROR'}, "Radiosity solve failed unexpectedly: %s: %s"
+                    % (type(err).__name__, err))
         return {'CANCELLED'}
 
     def _solve(self, context, solver):
         """Export the scene, solve with `solver` (the native module), bake the result."""
-        raise SolveError("Radiosity solver not implemented yet")
+        job = self._prepare(context, solver)
+        progress = None
+        if bpy.app.background:
+            last = [None]
 
+            def progress(p):
+                # Headless users see one line per pass.
+                if p.get("pass") != last[0]:
+                    last[0] = p.get("pass")
+                    print(progress_text(p), flush=True)
+        try:
+            job.result = solver.solve(job.native_scene, progress=progress, **job.options)
+        except ValueError as err:
+            raise SolveError("Radiosity: %s" % err) from None
+        return self._conclude(context, job)
+
+    def _prepare(self, context, solver):
+        """Export the scene and make the native Scene (main thread)."""
+        scene = context.scene
+        with bake.OriginalsShown(scene, context.view_layer):
+            exported = export.export_scene(context)
+        arrays = exported.arrays
+        note = export.unmodelled_message(exported.unmodelled)
+        if exported.face_count == 0:
+            raise SolveError("Nothing to solve: the scene has no visible mesh objects or area lights"
+                             + (" (%s)" % note if note else ""))
+        if not np.any(arrays["emission"] > 0):
+            raise SolveError("No light to solve: add an emissive material (Emission shader or "
+                             "Principled Emission) or an area light"
+                             + (" (%s)" % note if note else ""))
+        try:
+            native_scene = solver.Scene(arrays["positions"], arrays["face_vertices"], arrays["face_sizes"],
+                                        arrays["reflectance"], arrays["emission"], arrays["two_sided"])
+        except ValueError as err:
+            raise SolveError("Radiosity: %s" % err) from None
+        settings = scene.radiosity
+        label = settings.bl_rna.properties["oracle"].enum_items[settings.oracle].name
+        return Job(scene_name=scene.name, exported=exported, native_scene=native_scene,
+                   options=native_options(settings.solver_options()), oracle_label=label)
+
+    def _conclude(self, context, job):
+        """Report a finished job's error, or bake its result (main thread)."""
+        try:
+            if job.error is not None:
+                if isinstance(job.error, ValueError):
+                    raise SolveError("Radiosity: %s" % job.error)
+                raise job.error
+            return self._finish(context, job)
+        except SolveError as err:
+            self.report({'ERROR'}, str(err))
+        except Exception as err:
+            return self._unexpected(err)
+        return {'CANCELLED'}
+
+    def _finish(self, context, job):
+        """Bake the result into the scene and record the statistics."""
+        result = job.result
+        stats = result.stats
+        if len(result.face_sizes) == 0:
+            if stats.get("cancelled"):
+                raise SolveError("Radiosity solve cancelled before the first pass: scene unchanged")
+            raise SolveError("Radiosity: the solver returned no surfaces (every face degenerate?)")
+        scene = context.scene
+        settings = scene.radiosity
+        mode = settings.output
+        skipped_objects = []
+        if mode in {'REFINED', 'BOTH'}:
+            bake.write_refined(scene, job.exported, result, settings.show_wireframe)
+            bake.hide_originals(scene, context.view_layer, job.exported.hidden_sources)
+            bake.show_results(scene, True)
+        else:
+            bake.remove_results(scene)
+            bake.restore_originals(scene, context.view_layer)
+        if mode in {'ORIGINAL', 'BOTH'}:
+            skipped_objects = bake.write_original(scene, job.exported, result)
+        bake.set_viewport_attribute_colour()
+
+        warnings = []
+        note = export.unmodelled_message(job.exported.unmodelled)
+        if note:
+            warnings.append(note)
+        skipped_faces = len(job.native_scene.skipped_faces)
+        if skipped_faces:
+            warnings.append("%d degenerate face%s skipped" % (skipped_faces, "s" if skipped_faces > 1 else ""))
+        if skipped_objects:
+            warnings.append("no attribute on %s (instanced, shared or changed by modifiers)"
+                            % ", ".join(sorted(set(skipped_objects))))
+        s = settings.stats
+        s.valid = True
+        s.status = STATUS.get(stats.get("stopped_by", ""), str(stats.get("stopped_by", "")))
+        s.oracle = job.oracle_label
+        s.elements = int(stats.get("leaves", 0))
+        s.links = int(stats.get("links", 0))
+        s.iterations = int(stats.get("iterations", 0))
+        s.seconds = float(stats.get("seconds", 0.0))
+        s.warning = "; ".join(warnings)
+        if warnings:
+            self.report({'WARNING'}, s.warning)
+        self.report({'INFO'}, "Radiosity: %s, %s elements in %.2f s"
+                    % (s.status.lower(), "{:,}".format(s.elements), s.seconds))
+        return {'FINISHED'}
+
+
+class RADIOSITY_OT_toggle_result(Operator):
+    """Switch between showing the radiosity solution and the original objects"""
+
+    bl_idname = "radiosity.toggle_result"
+    bl_label = "Toggle Radiosity Result"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    @classmethod
+    def poll(cls, context):
+        return context.scene is not None and bool(bake.result_objects(context.scene))
+
+    def execute(self, context):
+        scene = context.scene
+        if any(o.get(export.HIDDEN_TAG) for o in scene.objects):
+            bake.restore_originals(scene, context.view_layer)
+            bake.show_results(scene, False)
+        else:
+            sources = {o[export.RESULT_TAG] for o in bake.result_objects(scene)}
+            bake.hide_originals(scene, context.view_layer, sorted(sources))
+            bake.show_results(scene, True)
+        return {'FINISHED'}
+
+
+class RADIOSITY_OT_clear(Operator):
+    """Remove the radiosity solution and show the original objects again"""
+
+    bl_idname = "radiosity.clear"
+    bl_label = "Remove Radiosity Result"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    @classmethod
+    def poll(cls, context):
+        return context.scene is not None
+
+    def execute(self, context):
+        scene = context.scene
+        bake.remove_results(scene)
+        coll = bake.result_collection(scene, create=False)
+        if coll is not None and not coll.all_objects:
+            bpy.data.collections.remove(coll)
+        bake.restore_originals(scene, context.view_layer)
+        bake.remove_original_attributes(scene)
+        scene.radiosity.stats.clear()
+        return {'FINISHED'}

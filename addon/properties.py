@@ -99,6 +99,12 @@ class RadiosityStats(PropertyGroup):
         self.seconds = 0.0
 
 
+def _update_wireframe(settings, context):
+    # Imported here: bake needs bpy data that registration does not.
+    from . import bake
+    bake.set_wireframe(settings.id_data, settings.show_wireframe)
+
+
 class RadiositySettings(PropertyGroup):
     """Radiosity solver settings of a scene."""
 
@@ -174,6 +180,7 @@ class RadiositySettings(PropertyGroup):
         name="Show Elements",
         description="Show the edges of the refined elements in the viewport",
         default=False,
+        update=_update_wireframe,
     )
     stats: PointerProperty(type=RadiosityStats)
 

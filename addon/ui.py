@@ -50,6 +50,9 @@ class RENDER_PT_radiosity(Panel):
         row = layout.row()
         row.scale_y = 1.5
         row.operator("radiosity.solve", icon='LIGHT_AREA')
+        row = layout.row(align=True)
+        row.operator("radiosity.toggle_result", icon='HIDE_OFF')
+        row.operator("radiosity.clear", icon='X')
         if native.error() is not None:
             box = layout.box()
             box.alert = True

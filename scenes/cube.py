@@ -1,7 +1,7 @@
 """`cube`: a closed 2 m cube room in the manner of the Cornell box.
 
 Red left wall, green right wall, the other four white; a 0.5 m square light
-just below the ceiling's centre; a 0.5 m white cube on the floor, turned a
+recessed in the ceiling's centre; a 0.5 m white cube on the floor, turned a
 little, casting a soft shadow; the camera inside, against the front wall,
 looking at the cube. Shows direct light, shadow and colour bleeding.
 """
@@ -27,11 +27,12 @@ def build(scene):
     red = kit.diffuse_material("Red", RED)
     green = kit.diffuse_material("Green", GREEN)
     colours = {"Wall.Left": red, "Wall.Right": green}
-    for name, geometry in kit.room_walls(ROOM_LO, ROOM_HI).items():
+    opening = kit.light_opening((0.0, 0.0), LIGHT_SIZE, LIGHT_SIZE)
+    for name, geometry in kit.room_walls(ROOM_LO, ROOM_HI, opening).items():
         kit.add_mesh(scene, name, geometry, colours.get(name, white))
 
-    # 1 cm below the ceiling, so that the two never overlap in a render.
-    light = kit.ceiling_light((0.0, 0.0, ROOM_HI[2] - 0.01), LIGHT_SIZE, LIGHT_SIZE)
+    # Recessed: flush with the ceiling, in an opening of it, so the two never overlap.
+    light = kit.ceiling_light((0.0, 0.0, ROOM_HI[2]), LIGHT_SIZE, LIGHT_SIZE)
     kit.add_mesh(scene, "Light", light, kit.emission_material("Light", LIGHT_STRENGTH))
 
     # No bottom face: it would lie on the floor, unseen and unlit.

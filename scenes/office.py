@@ -2,7 +2,7 @@
 
 White walls and ceiling, a pale blue back wall, a grey-brown floor; a wooden
 table (top 1.6 x 0.9 m, 0.76 m high) on four thin legs; a 1.2 x 0.6 m emitting
-panel on the ceiling above it; the camera high in a corner looking at the
+panel recessed in the ceiling above it; the camera high in a corner looking at the
 table and the far walls. Shows the shadow under the table and soft light on
 the walls.
 """
@@ -35,7 +35,8 @@ def build(scene):
         "Wall.Back": kit.diffuse_material("Back Wall", BACK_WALL),
     }
     wall = kit.diffuse_material("Wall", WALL)
-    for name, geometry in kit.room_walls(ROOM_LO, ROOM_HI).items():
+    opening = kit.light_opening(TABLE_CENTER, *LIGHT_SIZE)
+    for name, geometry in kit.room_walls(ROOM_LO, ROOM_HI, opening).items():
         kit.add_mesh(scene, name, geometry, materials.get(name, wall))
 
     cx, cy = TABLE_CENTER
@@ -51,7 +52,8 @@ def build(scene):
         kit.add_mesh(scene, "Table.Leg.%d" % i, leg, metal,
                      location=(cx + sx * dx, cy + sy * dy, leg_h / 2))
 
-    light = kit.ceiling_light((cx, cy, ROOM_HI[2] - 0.01), *LIGHT_SIZE)
+    # Recessed in an opening of the ceiling, flush with it.
+    light = kit.ceiling_light((cx, cy, ROOM_HI[2]), *LIGHT_SIZE)
     kit.add_mesh(scene, "Light", light, kit.emission_material("Light", LIGHT_STRENGTH))
 
     kit.add_camera(scene, location=(-2.3, -1.8, 1.7), target=(0.6, 0.9, 0.95), lens=18.0)

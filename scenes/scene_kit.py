@@ -49,11 +49,12 @@ def quad(origin, u, v):
     return np.array([o, o + u, o + u + v, o + v]), np.array([[0, 1, 2, 3]])
 
 
-def room_walls(lo, hi):
+def room_walls(lo, hi, opening=None):
     """The six inner faces of the room between corners lo and hi, normals inward.
 
     Returns {name: (vertices, quads)} for floor, ceiling and the walls
-    left (-x), right (+x), front (-y), back (+y).
+    left (-x), right (+x), front (-y), back (+y). `opening` = ((x0, y0), (x1, y1))
+    leaves a hole in the ceiling for a recessed light (ceiling_with_opening).
     """
     (x0, y0, z0), (x1, y1, z1) = lo, hi
     dx, dy, dz = x1 - x0, y1 - y0, z1 - z0
@@ -64,7 +65,39 @@ def room_walls(lo, hi):
         "Wall.Right": quad((x1, y0, z0), (0, 0, dz), (0, dy, 0)),
         "Wall.Front": quad((x0, y0, z0), (0, 0, dz), (dx, 0, 0)),
         "Wall.Back": quad((x0, y1, z0), (dx, 0, 0), (0, 0, dz)),
-    }
+    } | ({"Ceiling": ceiling_with_opening(lo, hi, *opening)} if opening else {})
+
+
+def light_opening(center, size_x, size_y):
+    """((x0, y0), (x1, y1)) of a light of size_x by size_y centred at `center` (x, y)."""
+    cx, cy = center[:2]
+    return (cx - size_x / 2, cy - size_y / 2), (cx + size_x / 2, cy + size_y / 2)
+
+
+def ceiling_with_opening(lo, hi, opening_lo, opening_hi):
+    """(vertices, quads) of a ceiling at z = hi[2] facing down, with a rectangular
+    opening between (x, y) corners opening_lo and opening_hi for a recessed light.
+
+    Four quads around the opening: the light sits in it, flush with the
+    ceiling, so no ceiling lies just above the light (a surface a centimetre
+    above an emitter's back is a hot spot that is hard to solve and unlike a
+    real recessed panel).
+    """
+    (x0, y0, _), (x1, y1, z) = lo, hi
+    (a0, b0), (a1, b1) = opening_lo, opening_hi
+    pieces = [
+        ((x0, y0), (x1, b0)),   # in front of the opening, full width
+        ((x0, b1), (x1, y1)),   # behind it, full width
+        ((x0, b0), (a0, b1)),   # left of it
+        ((a1, b0), (x1, b1)),   # right of it
+    ]
+    verts, quads = [], []
+    for (u0, v0), (u1, v1) in pieces:
+        n = len(verts)
+        # Counter-clockwise seen from below: normal -z.
+        verts += [(u0, v0, z), (u0, v1, z), (u1, v1, z), (u1, v0, z)]
+        quads.append((n, n + 1, n + 2, n + 3))
+    return np.array(verts, dtype=float), np.array(quads)
 
 
 def ceiling_light(center, size_x, size_y):

@@ -1,0 +1,316 @@
+"""Writes a solution into the Blender scene (Blender glue; the array work is geometry.py).
+
+- Refined output: one mesh object per exported part (object instance or area
+  light) in the "Radiosity" collection, carrying the adaptive refinement, with
+  a point-domain FLOAT_COLOR attribute "Radiosity" (radiance, as Cycles shows
+  it with the Standard view transform) and the "Radiosity Emission" material,
+  which emits that attribute with strength 1 and makes each polygon's back
+  face transparent: the two sides of a two-sided face are two coincident
+  polygons facing away from each other, and each is seen only from its side.
+  A re-solve replaces them; the originals are never edited, only hidden in
+  renders and viewport while the result is shown (reversibly, `restore_originals`).
+- Original output: a face-corner "Radiosity" attribute on the original meshes,
+  sampled from the solution at their corners, without refinement.
+"""
+
+import json
+
+import bpy
+import numpy as np
+
+from . import geometry
+from .export import HIDDEN_TAG, RESULT_TAG
+
+COLLECTION_NAME = "Radiosity"
+MATERIAL_NAME = "Radiosity Emission"
+ATTRIBUTE = "Radiosity"
+MATERIAL_TAG = "radiosity_material"
+# Each side's polygons move this fraction of the scene's size towards the side
+# they show (0.1 mm in a 2 m room), so the two sides of a face never coincide.
+SIDE_OFFSET = 5e-5
+
+
+# --- The Radiosity collection ----------------------------------------------------------
+
+def result_collection(scene, create=True):
+    """The scene's collection of result objects (made on demand)."""
+    for coll in scene.collection.children_recursive:
+        if coll.get(RESULT_TAG):
+            return coll
+    if not create:
+        return None
+    coll = bpy.data.collections.new(COLLECTION_NAME)
+    coll[RESULT_TAG] = True
+    scene.collection.children.link(coll)
+    return coll
+
+
+def result_objects(scene):
+    """The result objects of `scene`."""
+    return [o for o in scene.objects if o.get(RESULT_TAG)]
+
+
+def remove_results(scene):
+    """Delete the result objects and their meshes; keep the (emptied) collection."""
+    for obj in result_objects(scene):
+        mesh = obj.data
+        bpy.data.objects.remove(obj)
+        if mesh is not None and mesh.users == 0:
+            bpy.data.meshes.remove(mesh)
+
+
+def emission_material():
+    """The shared material that shows the "Radiosity" attribute as emitted radiance."""
+    for mat in bpy.data.materials:
+        if mat.get(MATERIAL_TAG):
+            return mat
+    mat = bpy.data.materials.new(MATERIAL_NAME)
+    mat[MATERIAL_TAG] = True
+    mat.use_nodes = True
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    nodes.clear()
+    attribute = nodes.new("ShaderNodeAttribute")
+    attribute.attribute_type = 'GEOMETRY'
+    attribute.attribute_name = ATTRIBUTE
+    attribute.location = (-600, 100)
+    emission = nodes.new("ShaderNodeEmission")
+    emission.inputs["Strength"].default_value = 1.0
+    emission.location = (-300, 100)
+    transparent = nodes.new("ShaderNodeBsdfTransparent")
+    transparent.location = (-300, -100)
+    backfacing = nodes.new("ShaderNodeNewGeometry")
+    backfacing.location = (-600, 300)
+    mix = nodes.new("ShaderNodeMixShader")
+    mix.location = (0, 100)
+    output = nodes.new("ShaderNodeOutputMaterial")
+    output.location = (250, 100)
+    links.new(attribute.outputs["Color"], emission.inputs["Color"])
+    links.new(backfacing.outputs["Backfacing"], mix.inputs["Fac"])
+    links.new(emission.outputs["Emission"], mix.inputs[1])
+    links.new(transparent.outputs["BSDF"], mix.inputs[2])
+    links.new(mix.outputs["Shader"], output.inputs["Surface"])
+    # EEVEE: back faces culled and no shadows (the light is baked in).
+    mat.use_backface_culling = True
+    mat.blend_method = 'CLIP'
+    mat.shadow_method = 'NONE'
+    mat.diffuse_color = (1.0, 1.0, 1.0, 1.0)
+    return mat
+
+
+# --- Refined output ----------------------------------------------------------------------
+
+def build_mesh(name, positions, face_vertices, face_sizes, radiance):
+    """A new mesh from arrays, with the point-domain "Radiosity" colour attribute."""
+    face_sizes = np.asarray(face_sizes, dtype=np.int32)
+    mesh = bpy.data.meshes.new(name)
+    mesh.vertices.add(len(positions))
+    mesh.vertices.foreach_set("co", np.ascontiguousarray(positions, dtype=np.float32).ravel())
+    mesh.loops.add(len(face_vertices))
+    mesh.loops.foreach_set("vertex_index", np.ascontiguousarray(face_vertices, dtype=np.int32))
+    mesh.polygons.add(len(face_sizes))
+    starts = (np.cumsum(face_sizes) - face_sizes).astype(np.int32)
+    mesh.polygons.foreach_set("loop_start", starts)
+    mesh.polygons.foreach_set("loop_total", face_sizes)
+    mesh.update(calc_edges=True)
+    set_colour_attribute(mesh, radiance, 'POINT')
+    return mesh
+
+
+def set_colour_attribute(mesh, rgb, domain):
+    """(Re)write the FLOAT_COLOR attribute "Radiosity" and make it active and rendered."""
+    old = mesh.color_attributes.get(ATTRIBUTE)
+    if old is not None:
+        mesh.color_attributes.remove(old)
+    attr = mesh.color_attributes.new(ATTRIBUTE, 'FLOAT_COLOR', domain)
+    rgba = np.ones((len(rgb), 4), dtype=np.float32)
+    rgba[:, :3] = rgb
+    attr.data.foreach_set("color", rgba.ravel())
+    mesh.color_attributes.active_color = attr
+    names = [a.name for a in mesh.color_attributes]
+    mesh.color_attributes.render_color_index = names.index(ATTRIBUTE)
+    return attr
+
+
+def write_refined(scene, exported, result, show_wireframe=False):
+    """Replace the result objects by the solution's meshes. Returns the new objects."""
+    face_part = exported.arrays["face_part"]
+    polygon_part = face_part[np.asarray(result.source_face, dtype=np.int64)]
+    pieces = geometry.split_result(result.face_vertices, result.face_sizes, polygon_part,
+                                   len(exported.parts))
+    face_sizes = np.asarray(result.face_sizes)
+    positions = np.asarray(result.positions)
+    if len(positions):
+        extent = float(np.ptp(positions, axis=0).max())
+        positions = geometry.offset_sides(positions, result.face_vertices, face_sizes,
+                                          SIDE_OFFSET * extent)
+    radiance = np.asarray(result.radiance)
+    material = emission_material()
+    new_objects = []
+    try:
+        for part, piece in zip(exported.parts, pieces):
+            if piece is None:
+                continue
+            polygons, vertices, local = piece
+            name = "%s Radiosity" % part.name
+            mesh = build_mesh(name, positions[vertices], local, face_sizes[polygons], radiance[vertices])
+            mesh.materials.append(material)
+            obj = bpy.data.objects.new(name, mesh)
+            obj[RESULT_TAG] = part.source
+            obj.show_wire = show_wireframe
+            obj.show_all_edges = True
+            new_objects.append(obj)
+    except Exception:
+        for obj in new_objects:
+            mesh = obj.data
+            bpy.data.objects.remove(obj)
+            bpy.data.meshes.remove(mesh)
+        raise
+    remove_results(scene)
+    coll = result_collection(scene)
+    for obj in new_objects:
+        coll.objects.link(obj)
+    return new_objects
+
+
+def set_wireframe(scene, show):
+    for obj in result_objects(scene):
+        obj.show_wire = show
+        obj.show_all_edges = True
+
+
+# --- Original output ---------------------------------------------------------------------
+
+def write_original(scene, exported, result):
+    """Write a face-corner "Radiosity" attribute onto the original meshes.
+
+    Only for objects whose evaluated mesh has the original's topology (no
+    generating modifiers), that are not instances and do not share their mesh.
+    Returns the names of objects skipped.
+    """
+    arrays = exported.arrays
+    extent = float(np.ptp(arrays["positions"], axis=0).max()) if len(arrays["positions"]) else 1.0
+    skipped = []
+    starts = np.cumsum([p.face_count for p in exported.parts]) - [p.face_count for p in exported.parts]
+    targets = []
+    for part, start in zip(exported.parts, starts):
+        if part.is_light or part.is_instance:
+            continue
+        obj = scene.objects.get(part.source)
+        mesh = obj.data if obj is not None and obj.type == 'MESH' else None
+        if (mesh is None or mesh.users > 1 or len(mesh.polygons) != part.face_count
+                or len(mesh.loops) != int(part.face_sizes.sum())):
+            skipped.append(part.source)
+            continue
+        targets.append((part, int(start), obj, mesh))
+    if not targets:
+        return skipped
+    # One matching pass over every target's corners.
+    points = np.concatenate([t[0].corner_points for t in targets])
+    sizes = np.concatenate([t[0].face_sizes for t in targets])
+    ids = np.concatenate([np.arange(t[1], t[1] + t[0].face_count) for t in targets])
+    values, _ = geometry.corner_values(points, sizes, ids, result.positions, result.face_vertices,
+                                       result.face_sizes, result.source_face, result.source_side,
+                                       result.radiance, tolerance=1e-7 * max(extent, 1e-9))
+    offset = 0
+    for part, _, obj, mesh in targets:
+        n = int(part.face_sizes.sum())
+        part_values = values[offset:offset + n]
+        offset += n
+        loop_start = np.empty(len(mesh.polygons), dtype=np.int32)
+        loop_total = np.empty(len(mesh.polygons), dtype=np.int32)
+        mesh.polygons.foreach_get("loop_start", loop_start)
+        mesh.polygons.foreach_get("loop_total", loop_total)
+        loops = geometry.polygon_corners(loop_start, loop_total, np.arange(len(mesh.loops)))
+        if np.linalg.det(np.array(obj.matrix_world)[:3, :3]) < 0:
+            loops = geometry.reverse_polygons(loops, loop_total)
+        per_loop = np.empty((len(mesh.loops), 3), dtype=np.float32)
+        per_loop[loops] = part_values
+        set_colour_attribute(mesh, per_loop, 'CORNER')
+    return skipped
+
+
+def remove_original_attributes(scene):
+    for obj in scene.objects:
+        if obj.type == 'MESH' and not obj.get(RESULT_TAG):
+            attr = obj.data.color_attributes.get(ATTRIBUTE)
+            if attr is not None:
+                obj.data.color_attributes.remove(attr)
+
+
+# --- Showing the result instead of the originals -----------------------------------------
+
+def hide_originals(scene, view_layer, names):
+    """Hide the named originals in renders and the viewport, remembering their state."""
+    for name in names:
+        obj = scene.objects.get(name)
+        if obj is None or obj.get(HIDDEN_TAG):
+            continue
+        in_layer = view_layer.objects.get(name) is not None
+        obj[HIDDEN_TAG] = json.dumps({"hide_render": obj.hide_render,
+                                      "hidden": obj.hide_get(view_layer=view_layer) if in_layer else False})
+        obj.hide_render = True
+        if in_layer:
+            obj.hide_set(True, view_layer=view_layer)
+
+
+def restore_originals(scene, view_layer):
+    """Undo hide_originals. Returns how many objects were restored."""
+    count = 0
+    for obj in scene.objects:
+        state = obj.get(HIDDEN_TAG)
+        if not state:
+            continue
+        state = json.loads(state)
+        obj.hide_render = state["hide_render"]
+        if view_layer.objects.get(obj.name) is not None:
+            obj.hide_set(state["hidden"], view_layer=view_layer)
+        del obj[HIDDEN_TAG]
+        count += 1
+    return count
+
+
+class OriginalsShown:
+    """Context manager: originals the add-on hid are visible inside (the export needs them
+    in the depsgraph), and hidden again on exit."""
+
+    def __init__(self, scene, view_layer):
+        self.scene, self.view_layer = scene, view_layer
+        self.hidden = []
+
+    def __enter__(self):
+        self.hidden = [o.name for o in self.scene.objects if o.get(HIDDEN_TAG)]
+        self.states = {n: self.scene.objects[n][HIDDEN_TAG] for n in self.hidden}
+        restore_originals(self.scene, self.view_layer)
+        if self.hidden:
+            self.view_layer.update()
+        return self
+
+    def __exit__(self, *exc):
+        for name in self.hidden:
+            obj = self.scene.objects.get(name)
+            if obj is None:
+                continue
+            obj[HIDDEN_TAG] = self.states[name]
+            obj.hide_render = True
+            if self.view_layer.objects.get(name) is not None:
+                obj.hide_set(True, view_layer=self.view_layer)
+        return False
+
+
+def show_results(scene, show):
+    """Show or hide the result objects (render and viewport)."""
+    for obj in result_objects(scene):
+        obj.hide_render = not show
+        obj.hide_viewport = not show
+
+
+def set_viewport_attribute_colour():
+    """Solid shading shows colour attributes in every 3D view that exists."""
+    for screen in bpy.data.screens:
+        for area in screen.areas:
+            if area.type != 'VIEW_3D':
+                continue
+            for space in area.spaces:
+                if space.type == 'VIEW_3D':
+                    items = space.shading.bl_rna.properties["color_type"].enum_items
+                    space.shading.color_type = 'ATTRIBUTE' if 'ATTRIBUTE' in items else 'VERTEX'

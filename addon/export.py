@@ -1,0 +1,311 @@
+"""Reads a Blender scene into the solver's arrays (Blender glue; the array work is geometry.py).
+
+What is exported, as a Cycles render would see it:
+- every visible, renderable mesh-like object of the evaluated depsgraph (modifiers
+  applied), including instances (collection instances, geometry-node and particle
+  instances), in world space; polygons as they are (the solver keeps planar quads
+  and triangulates the rest);
+- per face, the material's diffuse reflectance (Principled BSDF Base Color,
+  Diffuse BSDF Color, the average of an image texture feeding either, else the
+  viewport colour) and emitted radiance (Emission colour x strength of a
+  Principled BSDF or an Emission shader);
+- area lights as one-sided emitting polygons (rectangle, square, disk, ellipse)
+  with Blender's power-to-radiance conversion (geometry.area_light_factor).
+What is not modelled (point, spot and sun lights, node setups other than the
+above) is collected in `ExportedScene.unmodelled` for one warning.
+"""
+
+import math
+from dataclasses import dataclass, field
+
+import bpy
+import numpy as np
+
+from . import geometry
+
+# Objects the add-on itself made, which must never be solved again.
+RESULT_TAG = "radiosity_result"
+# Originals the add-on hid in renders, with their previous state (bake.py).
+HIDDEN_TAG = "radiosity_hidden"
+
+GEOMETRY_TYPES = {'MESH', 'CURVE', 'SURFACE', 'FONT', 'META'}
+DEFAULT_REFLECTANCE = (0.8, 0.8, 0.8)  # a face without material renders as grey 0.8 diffuse
+
+
+@dataclass
+class Part:
+    """One exported object instance or light: where its faces came from."""
+    name: str                 # name of the result object
+    source: str               # name of the original object (or light object)
+    is_instance: bool
+    is_light: bool
+    face_count: int
+    corner_points: np.ndarray = None   # (C, 3) world positions of its faces' corners
+    face_sizes: np.ndarray = None      # (F,) corners per face
+    materials: list = field(default_factory=list)  # material per face slot (None for none)
+    material_index: np.ndarray = None  # (F,) slot of each face
+
+
+@dataclass
+class ExportedScene:
+    arrays: dict
+    parts: list
+    unmodelled: list          # human-readable descriptions of what was not modelled
+    hidden_sources: list      # names of original objects whose render visibility the bake may toggle
+
+    @property
+    def face_count(self):
+        return len(self.arrays["face_sizes"])
+
+
+class MaterialReader:
+    """Reflectance and emission of materials, cached; records what it could not read."""
+
+    def __init__(self):
+        self._cache = {}
+        self._images = {}
+        self.unknown = set()
+
+    def read(self, material):
+        """(reflectance rgb, emission rgb) of `material` (None: default surface)."""
+        if material is None:
+            return np.array(DEFAULT_REFLECTANCE), np.zeros(3)
+        key = material.name_full
+        if key not in self._cache:
+            self._cache[key] = self._read(material)
+        return self._cache[key]
+
+    def _read(self, material):
+        viewport = np.array(material.diffuse_color[:3], dtype=float)
+        if not material.use_nodes or material.node_tree is None:
+            return viewport, np.zeros(3)
+        output = _active_output(material.node_tree)
+        if output is None or not output.inputs["Surface"].is_linked:
+            # Cycles renders a material without surface as black.
+            return np.zeros(3), np.zeros(3)
+        result = self._shader(_linked_node(output.inputs["Surface"]), material)
+        if result is None:
+            self.unknown.add(material.name)
+            return viewport, np.zeros(3)
+        return result
+
+    def _shader(self, node, material):
+        """(rho, emission) of a shader node, or None when it is not a known diffuse/emission setup."""
+        if node is None:
+            return np.zeros(3), np.zeros(3)
+        kind = node.type
+        if kind == 'BSDF_PRINCIPLED':
+            rho = self._colour(node.inputs["Base Color"], material)
+            emission = self._colour(node.inputs["Emission"], material)
+            strength = _scalar(node.inputs.get("Emission Strength"), 1.0)
+            if rho is None or emission is None or strength is None:
+                return None
+            return rho, emission * strength
+        if kind == 'BSDF_DIFFUSE':
+            rho = self._colour(node.inputs["Color"], material)
+            return None if rho is None else (rho, np.zeros(3))
+        if kind == 'EMISSION':
+            colour = self._colour(node.inputs["Color"], material)
+            strength = _scalar(node.inputs["Strength"], 1.0)
+            if colour is None or strength is None:
+                return None
+            return np.zeros(3), colour * strength
+        if kind == 'ADD_SHADER':
+            a, b = (self._shader(_linked_node(s), material) for s in node.inputs[:2])
+            if a is None or b is None:
+                return None
+            return a[0] + b[0], a[1] + b[1]
+        if kind == 'MIX_SHADER':
+            fac = _scalar(node.inputs[0], None)
+            a, b = (self._shader(_linked_node(s), material) for s in node.inputs[1:3])
+            if fac is None or a is None or b is None:
+                return None
+            return (1 - fac) * a[0] + fac * b[0], (1 - fac) * a[1] + fac * b[1]
+        return None
+
+    def _colour(self, socket, material):
+        """Linear RGB of a colour input: its value, an RGB node's, or an image's average."""
+        if not socket.is_linked:
+            return np.array(socket.default_value[:3], dtype=float)
+        node = _linked_node(socket)
+        if node is None:
+            return np.zeros(3)
+        if node.type == 'RGB':
+            return np.array(node.outputs[0].default_value[:3], dtype=float)
+        if node.type == 'TEX_IMAGE' and node.image is not None:
+            return self._image_average(node.image)
+        return None
+
+    def _image_average(self, image):
+        key = image.name_full
+        if key not in self._images:
+            self._images[key] = _image_average(image)
+        return self._images[key]
+
+
+def _image_average(image):
+    """Mean linear RGB of an image, or None if it has no pixels."""
+    width, height = image.size
+    channels = image.channels
+    if width * height == 0 or channels < 3:
+        return None
+    pixels = np.empty(width * height * channels, dtype=np.float32)
+    image.pixels.foreach_get(pixels)
+    rgb = pixels.reshape(-1, channels)[:, :3].astype(np.float64)
+    # Byte images hold their colour space's encoded values; float ones are linear.
+    if not image.is_float and image.colorspace_settings.name == 'sRGB':
+        rgb = geometry.srgb_to_linear(rgb)
+    return rgb.mean(axis=0)
+
+
+def _active_output(tree):
+    outputs = [n for n in tree.nodes if n.type == 'OUTPUT_MATERIAL' and n.target in {'ALL', 'CYCLES'}]
+    for node in outputs:
+        if node.is_active_output:
+            return node
+    return outputs[0] if outputs else None
+
+
+def _linked_node(socket):
+    """The node feeding `socket`, through reroutes; None if unlinked."""
+    while socket.is_linked:
+        link = socket.links[0]
+        if not link.is_valid or link.is_muted:
+            return None
+        node = link.from_node
+        if node.type != 'REROUTE':
+            return None if node.mute else node
+        socket = node.inputs[0]
+    return None
+
+
+def _scalar(socket, default):
+    """An unlinked float input's value; None if linked (not modelled)."""
+    if socket is None:
+        return default
+    if socket.is_linked:
+        return None
+    return float(socket.default_value)
+
+
+def _mesh_arrays(obj_eval):
+    """(positions (V,3) local, corners, face sizes, material index) of an evaluated object."""
+    mesh = obj_eval.to_mesh()
+    try:
+        nv, nl, npoly = len(mesh.vertices), len(mesh.loops), len(mesh.polygons)
+        positions = np.empty(3 * nv)
+        mesh.vertices.foreach_get("co", positions)
+        loop_vertex = np.empty(nl, dtype=np.int32)
+        mesh.loops.foreach_get("vertex_index", loop_vertex)
+        loop_start = np.empty(npoly, dtype=np.int32)
+        loop_total = np.empty(npoly, dtype=np.int32)
+        material_index = np.empty(npoly, dtype=np.int32)
+        mesh.polygons.foreach_get("loop_start", loop_start)
+        mesh.polygons.foreach_get("loop_total", loop_total)
+        mesh.polygons.foreach_get("material_index", material_index)
+    finally:
+        obj_eval.to_mesh_clear()
+    corners = geometry.polygon_corners(loop_start, loop_total, loop_vertex)
+    return positions.reshape(-1, 3), corners, loop_total.astype(np.int64), material_index
+
+
+def _renderable(obj):
+    """An original object that a render would show (our own results excluded)."""
+    if obj.get(RESULT_TAG):
+        return False
+    # Objects the add-on hid in renders are still part of the scene to solve.
+    return not obj.hide_render or bool(obj.get(HIDDEN_TAG))
+
+
+def export_scene(context, blender_version=None):
+    """Read the scene of `context` into an ExportedScene."""
+    depsgraph = context.evaluated_depsgraph_get()
+    version = tuple(blender_version or bpy.app.version)
+    builder = geometry.SceneBuilder()
+    reader = MaterialReader()
+    parts = []
+    lights_not_modelled = {}
+    light_notes = set()
+    hidden_sources = set()
+    names_used = {}
+
+    for inst in depsgraph.object_instances:
+        obj = inst.object
+        original = obj.original
+        owner = inst.parent.original if inst.is_instance and inst.parent else original
+        if not _renderable(original) or not _renderable(owner):
+            continue
+        if not (inst.show_self if inst.is_instance else True):
+            continue
+        matrix = np.array(inst.matrix_world, dtype=float)
+        if obj.type == 'LIGHT':
+            light = obj.data
+            if light.type != 'AREA':
+                kind = light.type.lower()
+                lights_not_modelled[kind] = lights_not_modelled.get(kind, 0) + 1
+                continue
+            local, area = geometry.area_light_polygon(light.shape, light.size, light.size_y)
+            area = geometry.scaled_area(matrix, area)
+            if area <= 0.0 or light.energy <= 0.0:
+                continue
+            radiance = (geometry.area_light_factor(version) * light.energy / area
+                        * np.array(light.color[:3], dtype=float))
+            if getattr(light, "spread", math.pi) < math.pi - 1e-6:
+                light_notes.add("area light spread")
+            if light.use_nodes:
+                light_notes.add("light node setups")
+            points = geometry.transform_points(local, matrix)
+            n = len(points)
+            builder.add(points, np.arange(n), [n], [0.0, 0.0, 0.0], radiance, False)
+            part = Part(name=_unique(names_used, original.name), source=owner.name,
+                        is_instance=inst.is_instance, is_light=True, face_count=1,
+                        corner_points=points, face_sizes=np.array([n]))
+            parts.append(part)
+            hidden_sources.add(owner.name)
+            continue
+        if obj.type not in GEOMETRY_TYPES:
+            continue
+        positions, corners, sizes, material_index = _mesh_arrays(obj)
+        if len(sizes) == 0:
+            continue
+        world = geometry.transform_points(positions, matrix)
+        if np.linalg.det(matrix[:3, :3]) < 0:
+            # A mirroring transform flips the winding; keep normals as Blender shows them.
+            corners = geometry.reverse_polygons(corners, sizes)
+        materials = [slot.material for slot in obj.material_slots] or [None]
+        table = [reader.read(m) for m in materials]
+        rho_table = np.array([t[0] for t in table])
+        emit_table = np.array([t[1] for t in table])
+        slot = np.clip(material_index, 0, len(materials) - 1)
+        builder.add(world, corners, sizes, rho_table[slot], emit_table[slot], True)
+        name = original.name if not inst.is_instance else "%s (%s)" % (original.name, owner.name)
+        parts.append(Part(name=_unique(names_used, name), source=owner.name,
+                          is_instance=inst.is_instance, is_light=False, face_count=len(sizes),
+                          corner_points=world[corners], face_sizes=sizes,
+                          materials=materials, material_index=slot))
+        hidden_sources.add(owner.name)
+
+    unmodelled = []
+    for kind in sorted(lights_not_modelled):
+        count = lights_not_modelled[kind]
+        unmodelled.append("%d %s light%s" % (count, kind, "s" if count > 1 else ""))
+    if reader.unknown:
+        unmodelled.append("material%s %s (unknown node setup: viewport colour used)"
+                          % ("s" if len(reader.unknown) > 1 else "", ", ".join(sorted(reader.unknown))))
+    unmodelled.extend(sorted(light_notes))
+    return ExportedScene(arrays=builder.arrays(), parts=parts, unmodelled=unmodelled,
+                         hidden_sources=sorted(hidden_sources))
+
+
+def _unique(used, name):
+    """`name`, or `name.2`, `name.3`... if taken already in this export."""
+    count = used.get(name, 0) + 1
+    used[name] = count
+    return name if count == 1 else "%s.%d" % (name, count)
+
+
+def unmodelled_message(unmodelled):
+    """One warning line for what the solve ignores, or ''."""
+    if not unmodelled:
+        return ""
+    return "Not modelled: " + "; ".join(unmodelled)
