@@ -669,6 +669,25 @@ TEST(SampledVisibility, EmbreeAgreesWithDoublePrecisionRays) {
   EXPECT_LE(disagreements, rays / 2000);
 }
 
+TEST(SampledVisibility, VectorisedRaysAgreeWithTheReferenceTest) {
+  // visible_fraction over candidates (origin fixed, vectorised) against
+  // segment_hits_triangle ray by ray.
+  std::mt19937_64 rng(53);
+  for (int i = 0; i < 40; ++i) {
+    const Configuration c = random_configuration(rng, 1 + i % 12, 0.3);
+    SampledVisibilityOptions options;
+    options.rays = 500;
+    options.seed = static_cast<std::uint64_t>(i);
+    const EmitterSamples samples = sample_emitter(c.r, c.n, c.emitter, options);
+    std::vector<std::uint8_t> blocked(samples.points.size(), 0);
+    for (std::size_t k = 0; k < samples.points.size(); ++k)
+      for (const Triangle& t : c.occluders)
+        blocked[k] = blocked[k] || segment_hits_triangle(c.r, samples.points[k], t);
+    EXPECT_DOUBLE_EQ(visible_fraction(c.occluders, c.r, samples), visible_fraction(samples, blocked))
+        << "configuration " << i;
+  }
+}
+
 TEST(SampledVisibility, OwnFacesNeverShadowTheLink) {
   // A blocker tagged with the receiver's face (or the emitter's) is ignored.
   const std::vector<Triangle> triangles{
