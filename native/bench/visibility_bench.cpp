@@ -250,6 +250,57 @@ void BM_ExactVisiblePolygon(benchmark::State& state) {
 }
 BENCHMARK(BM_ExactVisiblePolygon)->Arg(1)->Arg(4)->Arg(16)->Arg(64)->Unit(benchmark::kMicrosecond);
 
+// Closed meshes: N boxes (12 triangles each) in the pyramid, their quads as
+// consecutive triangle pairs (arg 1 = 1, merged into quads) or interleaved
+// (arg 1 = 0, subtracted triangle by triangle).
+void BM_ExactVisibleBoxes(benchmark::State& state) {
+  const int boxes = static_cast<int>(state.range(0));
+  const bool consecutive = state.range(1) != 0;
+  const Polygon emitter{{-0.5, -0.5, 2.0}, {-0.5, 0.5, 2.0}, {0.5, 0.5, 2.0}, {0.5, -0.5, 2.0}};
+  std::mt19937_64 rng(static_cast<std::uint64_t>(boxes));
+  std::vector<dvec3> points;
+  std::vector<std::vector<Triangle>> occluders;
+  for (int c = 0; c < 64; ++c) {
+    const dvec3 r = uniform_in(rng, {-0.3, -0.3, 0.0}, {0.3, 0.3, 0.0});
+    points.push_back(r);
+    std::vector<Triangle> tris;
+    const double size = 0.25 / std::sqrt(static_cast<double>(boxes));
+    for (int b = 0; b < boxes; ++b) {
+      const dvec3 target = uniform_in(rng, {-0.5, -0.5, 2.0}, {0.5, 0.5, 2.0});
+      const dvec3 lo = r + uniform_in(rng, dvec3(0.3), dvec3(0.7)) * (target - r);
+      const dvec3 hi = lo + uniform_in(rng, dvec3(0.5 * size), dvec3(size));
+      const auto corner = [&](int i) {
+        return dvec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
+      };
+      const int faces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+      for (const auto& f : faces) {
+        tris.push_back(Triangle{{corner(f[0]), corner(f[1]), corner(f[2])}});
+        tris.push_back(Triangle{{corner(f[0]), corner(f[2]), corner(f[3])}});
+      }
+    }
+    if (!consecutive) {
+      std::vector<Triangle> apart;
+      for (std::size_t k = 0; k < tris.size(); k += 2) apart.push_back(tris[k]);
+      for (std::size_t k = 1; k < tris.size(); k += 2) apart.push_back(tris[k]);
+      tris = apart;
+    }
+    occluders.push_back(tris);
+  }
+  const dvec3 n(0.0, 0.0, 1.0);
+  double pieces = 0.0;
+  for (std::size_t k = 0; k < points.size(); ++k)
+    pieces += static_cast<double>(visible_polygon(points[k], n, emitter, occluders[k]).pieces.size());
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const FormFactorGradient fg = visible_form_factor_gradient(points[i], n, emitter, occluders[i]);
+    benchmark::DoNotOptimize(fg.value);
+    i = (i + 1) % points.size();
+  }
+  state.counters["triangles"] = 12 * boxes;
+  state.counters["pieces"] = pieces / static_cast<double>(points.size());
+}
+BENCHMARK(BM_ExactVisibleBoxes)->ArgsProduct({{1, 4, 16}, {0, 1}})->Unit(benchmark::kMicrosecond);
+
 // Sampled mode, 4 occluders: cost per evaluation (Embree rays; the scene is built
 // once per configuration, outside the timing) and the mean error against the
 // exact F relative to the unoccluded F, over 64 configurations.

@@ -281,50 +281,49 @@ bool clip_space(Workspace& w, const dvec3& m, const dvec3& o, std::int32_t bound
   return w.space_a.size() >= 3;
 }
 
-// Projects occluder `tri` from r onto the emitter plane, clipped to the pyramid
-// from r through the (horizon-clipped) emitter, into w.occluder (convex,
-// counter-clockwise). Returns false if nothing of positive area remains.
-bool project_occluder(const Triangle& tri, Workspace& w) {
+// Projects an occluder (a planar convex polygon: a triangle, or two coplanar
+// triangles merged into a quad) from r onto the emitter plane, clipped to the
+// pyramid from r through the (horizon-clipped) emitter, into w.occluder
+// (convex, counter-clockwise). Returns false if nothing of positive area remains.
+bool project_occluder(std::span<const dvec3> poly, Workspace& w) {
   const EmitterFrame& f = w.frame;
   const double tol = w.tol.space;
   const dvec3& r = w.r;
-  // Skip what cannot block: degenerate triangles, triangles whose plane holds r
-  // (they project to a segment), triangles on or behind the emitter plane
+  // Skip what cannot block: degenerate polygons, polygons whose plane holds r
+  // (they project to a segment), polygons on or behind the emitter plane
   // (coplanar faces are the emitter's neighbours, not blockers).
-  const dvec3 nt = glm::cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]);
+  dvec3 nt(0.0);
+  for (std::size_t i = 1; i + 1 < poly.size(); ++i)
+    nt += glm::cross(poly[i] - poly[0], poly[i + 1] - poly[0]);
   const double nt_len = glm::length(nt);
   if (!(nt_len > 0.0)) return false;
   const dvec3 nt_unit = nt / nt_len;
-  if (std::abs(glm::dot(nt_unit, r - tri.v[0])) <= tol) return false;
+  if (std::abs(glm::dot(nt_unit, r - poly[0])) <= tol) return false;
   double hmax = -1.0;
-  for (const dvec3& x : tri.v) hmax = std::max(hmax, f.height(x));
+  for (const dvec3& x : poly) hmax = std::max(hmax, f.height(x));
   if (hmax <= tol) return false;
 
-  // Quick reject: the whole triangle outside (or on) one side plane of the
+  // Quick reject: the whole polygon outside (or on) one side plane of the
   // pyramid (through r and an emitter edge, normal pointing inwards).
   const std::size_t k = w.corners.size();
-  std::vector<dvec3>& side_normal = w.side_normals;
-  side_normal.resize(k);
+  const std::vector<dvec3>& side_normal = w.side_normals;
   for (std::size_t i = 0; i < k; ++i) {
-    const dvec3 vi = w.corners[i], vj = w.corners[(i + 1) % k];
-    const dvec3 m = glm::cross(r - vi, vj - vi);
-    const double ml = glm::length(m);
-    side_normal[i] = ml > 0.0 ? m / ml : dvec3(0.0);
-    if (!(ml > 0.0)) continue;
-    if (glm::dot(side_normal[i], tri.v[0] - r) <= tol && glm::dot(side_normal[i], tri.v[1] - r) <= tol &&
-        glm::dot(side_normal[i], tri.v[2] - r) <= tol)
-      return false;
+    if (side_normal[i] == dvec3(0.0)) continue;
+    bool all_out = true;
+    for (const dvec3& x : poly) all_out = all_out && glm::dot(side_normal[i], x - r) <= tol;
+    if (all_out) return false;
   }
 
   const auto first_line = static_cast<std::int32_t>(w.lines.size());
   const auto first_anchor = static_cast<std::int32_t>(w.anchors.size());
   w.space_a.clear();
-  for (int i = 0; i < 3; ++i) {
-    const dvec3 a = tri.v[i], b = tri.v[(i + 1) % 3];
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const dvec3 a = poly[i], b = poly[(i + 1) % poly.size()];
     const bool planar = std::abs(f.height(a)) <= tol && std::abs(f.height(b)) <= tol;
     w.add_line({Line{a, b - a}, planar, false});
     w.anchors.push_back(a);
-    w.space_a.push_back({a, Tag{-1, -1, first_anchor + i, first_line + i}});
+    const auto index = static_cast<std::int32_t>(i);
+    w.space_a.push_back({a, Tag{-1, -1, first_anchor + index, first_line + index}});
   }
   for (std::size_t i = 0; i < k; ++i) {
     if (side_normal[i] == dvec3(0.0)) continue;
@@ -340,7 +339,7 @@ bool project_occluder(const Triangle& tri, Workspace& w) {
     trace.line.direction = glm::cross(nt_unit, f.normal);
     const double dd = glm::dot(trace.line.direction, trace.line.direction);
     if (dd > 1e-24) {
-      const double h1 = glm::dot(nt_unit, tri.v[0]), h2 = glm::dot(f.normal, f.origin);
+      const double h1 = glm::dot(nt_unit, poly[0]), h2 = glm::dot(f.normal, f.origin);
       trace.line.point = (h1 * glm::cross(f.normal, trace.line.direction) +
                           h2 * glm::cross(trace.line.direction, nt_unit)) / dd;
     } else {
@@ -470,7 +469,44 @@ bool setup(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter, Works
   if (!clean_tail(w.emitter, 0, w.tol)) return false;
   w.corners.clear();
   for (const PlaneVertex& v : w.emitter) w.corners.push_back(w.frame.to_space(v.p));
+  // Side planes of the pyramid from r through the emitter: through r and each
+  // edge, normal pointing inwards ((r - v_i) x e_i, counter-clockwise corners).
+  const std::size_t corners = w.corners.size();
+  w.side_normals.resize(corners);
+  for (std::size_t i = 0; i < corners; ++i) {
+    const dvec3 vi = w.corners[i], vj = w.corners[(i + 1) % corners];
+    const dvec3 m = glm::cross(r - vi, vj - vi);
+    const double ml = glm::length(m);
+    w.side_normals[i] = ml > 0.0 ? m / ml : dvec3(0.0);
+  }
   return true;
+}
+
+// Triangles a and b share an edge (the same two vertices) and together form a
+// planar, strictly convex quad: writes it (in a's orientation) to `quad`.
+bool merge_into_quad(const Triangle& a, const Triangle& b, double tol, dvec3 quad[4]) {
+  for (int e = 0; e < 3; ++e) {
+    const dvec3& p = a.v[e];
+    const dvec3& q = a.v[(e + 1) % 3];
+    const dvec3& other = a.v[(e + 2) % 3];
+    int ip = -1, iq = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (b.v[k] == p) ip = k;
+      if (b.v[k] == q) iq = k;
+    }
+    if (ip < 0 || iq < 0) continue;
+    const dvec3& x = b.v[3 - ip - iq];
+    quad[0] = p, quad[1] = x, quad[2] = q, quad[3] = other;
+    const dvec3 n = glm::cross(q - p, other - p);
+    const double n_len = glm::length(n);
+    if (!(n_len > 0.0) || std::abs(glm::dot(n / n_len, x - p)) > tol) return false;
+    for (int i = 0; i < 4; ++i) {
+      const dvec3 turn = glm::cross(quad[(i + 1) % 4] - quad[i], quad[(i + 2) % 4] - quad[(i + 1) % 4]);
+      if (!(glm::dot(turn, n) > 1e-12 * n_len * n_len)) return false;
+    }
+    return true;
+  }
+  return false;
 }
 
 // Runs the whole method; the visible pieces are left in w.pieces / w.start.
@@ -481,9 +517,17 @@ bool compute_visible_pieces(const dvec3& r, const dvec3& n, std::span<const dvec
   if (emitter.size() < 3 || !setup(r, n, emitter, w)) return false;
   w.pieces.assign(w.emitter.begin(), w.emitter.end());
   w.start.assign({0u, static_cast<std::uint32_t>(w.emitter.size())});
-  for (const Triangle& tri : occluders) {
+  dvec3 quad[4];
+  for (std::size_t i = 0; i < occluders.size(); ++i) {
     const std::size_t lines = w.lines.size(), anchors = w.anchors.size();
-    if (!project_occluder(tri, w)) {
+    // Two consecutive triangles that make a planar convex quad (a mesh quad split
+    // in two) are one occluder: no cut along their shared diagonal.
+    std::span<const dvec3> poly(occluders[i].v);
+    if (i + 1 < occluders.size() && merge_into_quad(occluders[i], occluders[i + 1], w.tol.space, quad)) {
+      poly = std::span<const dvec3>(quad, 4);
+      ++i;
+    }
+    if (!project_occluder(poly, w)) {
       // Nothing of it is in the way: forget its lines.
       w.lines.resize(lines);
       w.anchors.resize(anchors);
