@@ -13,7 +13,9 @@
 //     bounded, even for occluders that reach behind the point or behind the emitter.
 //  3. Its projection (a convex polygon) is subtracted from every visible piece by
 //     successive half-plane clipping. The artificial cut edges between pieces
-//     cancel in both F and its gradient.
+//     cancel in both F and its gradient. Two consecutive occluder triangles that
+//     form a planar convex quad (a mesh quad split in two) are subtracted as one
+//     quad, which saves the cuts along their diagonal.
 // Every edge carries the 3D line that generates it (an emitter edge, an occluder
 // edge, the trace of an occluder plane on the emitter plane, or the receiver's
 // horizon); every vertex is the crossing of its two edges: intrinsic when the two
