@@ -156,6 +156,7 @@ def write_refined(scene, exported, result, show_wireframe=False):
             mesh.materials.append(material)
             obj = bpy.data.objects.new(name, mesh)
             obj[RESULT_TAG] = part.source
+            obj["radiosity_name"] = name
             obj.show_wire = show_wireframe
             obj.show_all_edges = True
             new_objects.append(obj)
@@ -169,6 +170,8 @@ def write_refined(scene, exported, result, show_wireframe=False):
     coll = result_collection(scene)
     for obj in new_objects:
         coll.objects.link(obj)
+        # Made while the old results still held the names: take them back.
+        obj.name = obj.data.name = obj["radiosity_name"]
     return new_objects
 
 

@@ -7,4 +7,13 @@ an empty Blender scene (see build_scene.py).
 SCENES = {
     "cube": "closed cube room, red and green side walls, ceiling light, small cube casting a shadow",
     "office": "5 x 4 x 3 m room, table with four legs under a ceiling light",
+    "full_office": "the office plus a chair, shelves and a cabinet: high occlusion",
+    "dining_room": "8 x 6 x 3 m room, one small bright light over a table with chairs, dim corners",
+    "gradient_large_45": "Section 4.3.1 Fig. 22: occluder at 45 degrees, large emitter",
+    "gradient_small_45": "Section 4.3.1 Fig. 23: occluder at 45 degrees, small emitter",
+    "gradient_large_aligned": "Section 4.3.1 Fig. 24: occluder aligned, large emitter",
+    "gradient_small_aligned": "Section 4.3.1 Fig. 25: occluder aligned, small emitter",
 }
+
+# Closed rooms (walls, floor, ceiling), as opposed to the open Section 4.3.1 set-ups.
+ROOMS = ("cube", "office", "full_office", "dining_room")

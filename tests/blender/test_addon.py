@@ -21,6 +21,8 @@ ADDON_TYPES = (
     (bpy.types.PropertyGroup, "RadiosityStats"),
     (bpy.types.PropertyGroup, "RadiositySettings"),
     (bpy.types.Operator, "RADIOSITY_OT_solve"),
+    (bpy.types.Operator, "RADIOSITY_OT_toggle_result"),
+    (bpy.types.Operator, "RADIOSITY_OT_clear"),
     (bpy.types.Panel, "RENDER_PT_radiosity"),
 )
 
@@ -199,7 +201,7 @@ class PanelTest(unittest.TestCase):
         # The add-on's own settings; `stats` is drawn as labels.
         settings = set(properties.RadiositySettings.__annotations__) - {"stats"}
         self.assertEqual(drawn, settings)
-        self.assertEqual(record["operators"], ["radiosity.solve"])
+        self.assertEqual(record["operators"], ["radiosity.solve", "radiosity.toggle_result", "radiosity.clear"])
         self.assertIn("Not solved yet", record["labels"])
 
     def test_draws_last_solve_statistics(self):
@@ -255,14 +257,17 @@ class OperatorTest(unittest.TestCase):
         finally:
             bpy.ops.object.mode_set(mode='OBJECT')
 
-    def test_reports_not_implemented_and_changes_nothing(self):
-        # Blender turns an ERROR report of a cancelled operator into RuntimeError
-        # for Python callers; the return value {'CANCELLED'} is checked below.
+    def test_reports_no_light_and_changes_nothing(self):
+        # The factory scene has a cube and a point light, which has no area:
+        # nothing emits. Blender turns an ERROR report of a cancelled operator
+        # into RuntimeError for Python callers; the return value {'CANCELLED'}
+        # is checked below.
         scene = bpy.context.scene
         before = scene_snapshot(scene)
         for context in ('EXEC_DEFAULT', 'INVOKE_DEFAULT'):
             message = self.solve_error(context)
-            self.assertIn("Radiosity solver not implemented yet", message)
+            self.assertIn("No light to solve", message)
+            self.assertIn("Not modelled: 1 point light", message)
             self.assertEqual(scene_snapshot(scene), before)
 
     def test_returns_cancelled(self):
@@ -273,13 +278,17 @@ class OperatorTest(unittest.TestCase):
 
         class Stub:
             _solve = operators.RADIOSITY_OT_solve._solve
+            _prepare = operators.RADIOSITY_OT_solve._prepare
+            _unexpected = operators.RADIOSITY_OT_solve._unexpected
 
             def report(self, kind, message):
                 reports.append((kind, message))
 
         result = operators.RADIOSITY_OT_solve._run(Stub(), bpy.context)
         self.assertEqual(result, {'CANCELLED'})
-        self.assertEqual(reports, [({'ERROR'}, "Radiosity solver not implemented yet")])
+        self.assertEqual(len(reports), 1)
+        self.assertEqual(reports[0][0], {'ERROR'})
+        self.assertIn("No light to solve", reports[0][1])
 
     def test_missing_native_module_is_reported(self):
         def unavailable():

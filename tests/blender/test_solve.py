@@ -1,0 +1,358 @@
+"""Solving bundled scenes through the operator, and what the bake leaves (headless Blender).
+
+The cube scene is built once into a temporary .blend; each test opens it
+fresh. Covers every oracle, the result meshes and their attribute, lit versus
+shadowed surfaces, colour bleeding, re-solving, undo, clear/toggle, the
+original-mesh output, errors that change nothing, cancelling (through the
+same worker and conclude code the interactive path uses), and the command
+line `blender -b file.blend --python-expr "...solve()"`.
+"""
+
+import os
+import subprocess
+import sys
+import tempfile
+import threading
+import unittest
+
+import bpy
+import numpy as np
+
+from radiosity import bake, export, native, operators
+
+sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "scenes")))
+import build_scene  # noqa: E402
+from test_addon import scene_snapshot  # noqa: E402
+
+ADDON_DIR = os.path.dirname(os.path.dirname(os.path.abspath(bake.__file__)))
+TMP = tempfile.mkdtemp(prefix="radiosity-test-")
+
+
+def build_file(name):
+    """Build scene `name` into TMP/name.blend (once) and return the path."""
+    path = os.path.join(TMP, name + ".blend")
+    if not os.path.exists(path):
+        bpy.ops.wm.read_homefile(use_empty=True)
+        scene = bpy.context.scene
+        build_scene.build(name, scene)
+        bpy.ops.wm.save_as_mainfile(filepath=path, copy=True)
+    return path
+
+
+def open_scene(name):
+    bpy.ops.wm.open_mainfile(filepath=build_file(name))
+    return bpy.context.scene
+
+
+def attribute(obj):
+    """(V, 3) values of the point-domain "Radiosity" attribute."""
+    attr = obj.data.color_attributes["Radiosity"]
+    values = np.empty(4 * len(attr.data), dtype=np.float32)
+    attr.data.foreach_get("color", values)
+    return values.reshape(-1, 4)[:, :3]
+
+
+def positions(obj):
+    co = np.empty(3 * len(obj.data.vertices))
+    obj.data.vertices.foreach_get("co", co)
+    return co.reshape(-1, 3)
+
+
+def results(scene):
+    return {o[export.RESULT_TAG]: o for o in bake.result_objects(scene)}
+
+
+def luminance(rgb):
+    return rgb @ np.array([0.2126, 0.7152, 0.0722])
+
+
+class SolveCubeTest(unittest.TestCase):
+    def test_every_oracle(self):
+        for oracle in ('STANDARD', 'PERCEPTUAL', 'GRADIENT'):
+            with self.subTest(oracle=oracle):
+                scene = open_scene("cube")
+                scene.radiosity.oracle = oracle
+                self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
+                stats = scene.radiosity.stats
+                self.assertTrue(stats.valid)
+                self.assertEqual(stats.status, "Converged")
+                self.assertGreater(stats.elements, 24)
+                self.assertGreater(stats.links, 0)
+                self.check_result(scene)
+
+    def check_result(self, scene):
+        out = results(scene)
+        meshes = {o.name for o in scene.objects if o.type == 'MESH' and not o.get(export.RESULT_TAG)}
+        self.assertEqual(set(out), meshes)
+        coll = bake.result_collection(scene, create=False)
+        self.assertEqual(coll.name, "Radiosity")
+        for name, obj in out.items():
+            self.assertEqual(obj.users_collection[0], coll)
+            attr = obj.data.color_attributes["Radiosity"]
+            self.assertEqual((attr.data_type, attr.domain), ('FLOAT_COLOR', 'POINT'))
+            self.assertEqual(obj.data.color_attributes.active_color.name, "Radiosity")
+            names = [a.name for a in obj.data.color_attributes]
+            self.assertEqual(names[obj.data.color_attributes.render_color_index], "Radiosity")
+            values = attribute(obj)
+            self.assertEqual(len(values), len(obj.data.vertices))
+            self.assertTrue(np.all(np.isfinite(values)), name)
+            self.assertTrue(np.all(values >= 0), name)
+            self.assertEqual(obj.data.materials[0].name, bake.MATERIAL_NAME)
+            # The original is hidden in renders and the viewport, not edited.
+            original = scene.objects[name]
+            self.assertTrue(original.hide_render)
+            self.assertNotIn("Radiosity", original.data.color_attributes)
+        # The light shows its own radiance (12, cube.py), on its lit side.
+        np.testing.assert_allclose(attribute(out["Light"]), 12.0, rtol=1e-5)
+        # Refinement happened where light changes: the floor has far more vertices than 4.
+        self.assertGreater(len(out["Floor"].data.vertices), 50)
+
+    def test_lit_brighter_than_shadowed_and_colour_bleeding(self):
+        scene = open_scene("cube")
+        bpy.ops.radiosity.solve()
+        out = results(scene)
+        floor = out["Floor"]
+        p, v = positions(floor), luminance(attribute(floor))
+        # The small cube stands at (0.3, 0.05) turned 20 degrees; right next to
+        # it, away from the light, the floor is in its shadow; under the light
+        # (x, y near 0, cube's left side) and far in the open it is lit.
+        cube = scene.objects["Cube"]
+        centre = np.array(cube.location[:2])
+        d = np.linalg.norm(p[:, :2] - centre, axis=1)
+        away = (p[:, :2] - centre) @ (centre / np.linalg.norm(centre))
+        shadow = (d > 0.36) & (d < 0.45) & (away > 0.3)
+        lit = np.linalg.norm(p[:, :2] - [-0.3, -0.3], axis=1) < 0.15
+        self.assertTrue(shadow.any() and lit.any())
+        self.assertGreater(v[lit].mean(), 1.5 * v[shadow].mean())
+        # The cube's top (facing the light) is brighter than its sides.
+        cube_out = out["Cube"]
+        cp, cv = positions(cube_out), luminance(attribute(cube_out))
+        top = cp[:, 2] > 0.499
+        self.assertGreater(cv[top].mean(), cv[~top].mean())
+        # Colour bleeding: the white back wall is redder near the red left wall
+        # (x = -1) than near the green right wall (x = +1).
+        back = out["Wall.Back"]
+        bp, bv = positions(back), attribute(back)
+        redness = bv[:, 0] / np.maximum(bv[:, 1], 1e-9)
+        near_red, near_green = bp[:, 0] < -0.8, bp[:, 0] > 0.8
+        self.assertGreater(redness[near_red].mean(), 1.1 * redness[near_green].mean())
+        self.assertGreater(redness[near_red].mean(), 1.05)   # white is red/green = 1
+
+    def test_resolve_replaces_results(self):
+        scene = open_scene("cube")
+        bpy.ops.radiosity.solve()
+        first = sorted(o.name for o in bake.result_objects(scene))
+        mesh_count = len(bpy.data.meshes)
+        scene.radiosity.oracle = 'STANDARD'
+        bpy.ops.radiosity.solve()
+        second = sorted(o.name for o in bake.result_objects(scene))
+        self.assertEqual(first, second)
+        self.assertEqual(len(bpy.data.meshes), mesh_count)
+        self.assertEqual(len([c for c in bpy.data.collections if c.get(export.RESULT_TAG)]), 1)
+        self.assertEqual(len([m for m in bpy.data.materials if m.get(bake.MATERIAL_TAG)]), 1)
+        # Hidden originals are still solved (not dropped because we hid them).
+        self.assertEqual(len(second), 8)
+
+    def test_clear_and_toggle_restore_the_originals(self):
+        scene = open_scene("cube")
+        before = scene_snapshot(scene)
+        bpy.ops.radiosity.solve()
+        self.assertEqual(bpy.ops.radiosity.toggle_result(), {'FINISHED'})
+        self.assertFalse(scene.objects["Floor"].hide_render)
+        self.assertTrue(all(o.hide_render for o in bake.result_objects(scene)))
+        bpy.ops.radiosity.toggle_result()
+        self.assertTrue(scene.objects["Floor"].hide_render)
+        self.assertFalse(any(o.hide_render for o in bake.result_objects(scene)))
+        bpy.ops.radiosity.clear()
+        after = scene_snapshot(scene)
+        # Everything as before but the shared emission material, kept for re-use.
+        after["materials"].remove(bake.MATERIAL_NAME)
+        self.assertEqual(after, before)
+
+    def test_undo_restores(self):
+        # Global (memfile) undo works in background mode, but operators called
+        # from a script push no undo step of their own (the window manager does
+        # that for UI calls of an operator with 'UNDO', as this one has), and
+        # ed.undo's poll fails with fewer than two steps. So the test pushes
+        # the steps the UI would: before, and after the solve; then undoes.
+        scene = open_scene("cube")
+        before = scene_snapshot(scene)
+        bpy.ops.ed.undo_push(message="before solve")
+        bpy.ops.radiosity.solve()
+        bpy.ops.ed.undo_push(message="Solve Radiosity")
+        self.assertTrue(bake.result_objects(bpy.context.scene))
+        bpy.ops.ed.undo()
+        scene = bpy.context.scene
+        self.assertFalse(bake.result_objects(scene))
+        self.assertEqual(scene_snapshot(scene), before)
+
+    def test_original_output(self):
+        scene = open_scene("cube")
+        scene.radiosity.output = 'ORIGINAL'
+        self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
+        self.assertFalse(bake.result_objects(scene))
+        floor = scene.objects["Floor"]
+        self.assertFalse(floor.hide_render)
+        attr = floor.data.color_attributes["Radiosity"]
+        self.assertEqual((attr.data_type, attr.domain), ('FLOAT_COLOR', 'CORNER'))
+        values = np.empty(4 * len(attr.data), dtype=np.float32)
+        attr.data.foreach_get("color", values)
+        self.assertTrue(np.all(np.isfinite(values)) and np.all(values >= 0))
+        # The corners of the cube's top: lit, so non-zero.
+        top = scene.objects["Cube"].data.color_attributes["Radiosity"]
+        self.assertEqual(len(top.data), 20)
+        # BOTH writes both.
+        scene.radiosity.output = 'BOTH'
+        bpy.ops.radiosity.solve()
+        self.assertTrue(bake.result_objects(scene))
+        self.assertIn("Radiosity", floor.data.color_attributes)
+
+    def test_wireframe_option(self):
+        scene = open_scene("cube")
+        scene.radiosity.show_wireframe = True
+        bpy.ops.radiosity.solve()
+        self.assertTrue(all(o.show_wire for o in bake.result_objects(scene)))
+        scene.radiosity.show_wireframe = False
+        self.assertFalse(any(o.show_wire for o in bake.result_objects(scene)))
+
+
+class FailureTest(unittest.TestCase):
+    def solve_error(self):
+        with self.assertRaises(RuntimeError) as caught:
+            bpy.ops.radiosity.solve()
+        message = str(caught.exception)
+        self.assertNotIn("Traceback", message)
+        return message
+
+    def test_no_emitter_changes_nothing(self):
+        scene = open_scene("cube")
+        for mat in bpy.data.materials:
+            for node in mat.node_tree.nodes:
+                if node.type == 'EMISSION':
+                    node.inputs["Strength"].default_value = 0.0
+        bpy.data.lights.new("Point", 'POINT')
+        point = bpy.data.objects.new("Point", bpy.data.lights["Point"])
+        scene.collection.objects.link(point)
+        before = scene_snapshot(scene)
+        message = self.solve_error()
+        self.assertIn("No light to solve", message)
+        self.assertIn("1 point light", message)   # said why the point light does not count
+        self.assertEqual(scene_snapshot(scene), before)
+
+    def test_only_degenerate_faces(self):
+        scene = open_scene("cube")
+        for obj in list(scene.objects):
+            if obj.type == 'MESH':
+                bpy.data.objects.remove(obj)
+        mesh = bpy.data.meshes.new("Flat")
+        mesh.from_pydata([(0, 0, 0), (1, 0, 0), (2, 0, 0), (3, 0, 0)], [], [(0, 1, 2, 3)])
+        mesh.materials.append(bpy.data.materials["Light"])
+        scene.collection.objects.link(bpy.data.objects.new("Flat", mesh))
+        before = scene_snapshot(scene)
+        message = self.solve_error()
+        self.assertIn("degenerate", message)
+        self.assertEqual(scene_snapshot(scene), before)
+
+    def test_empty_scene(self):
+        scene = open_scene("cube")
+        for obj in list(scene.objects):
+            if obj.type == 'MESH':
+                bpy.data.objects.remove(obj)
+        before = scene_snapshot(scene)
+        self.assertIn("Nothing to solve", self.solve_error())
+        self.assertEqual(scene_snapshot(scene), before)
+
+
+class Reports:
+    """Stand-in for the operator: collects reports, runs the operator's methods."""
+    _prepare = operators.RADIOSITY_OT_solve._prepare
+    _conclude = operators.RADIOSITY_OT_solve._conclude
+    _finish = operators.RADIOSITY_OT_solve._finish
+    _unexpected = operators.RADIOSITY_OT_solve._unexpected
+    _work = staticmethod(operators.RADIOSITY_OT_solve._work)
+
+    def __init__(self):
+        self.reports = []
+
+    def report(self, kind, message):
+        self.reports.append((kind, message))
+
+
+class CancelTest(unittest.TestCase):
+    """The interactive path without a window: worker thread, cancel token, conclude."""
+
+    def run_worker(self, cancel_at_pass):
+        scene = open_scene("cube")
+        scene.radiosity.quality = 1.0
+        self.before = scene_snapshot(scene)
+        solver = native.load()
+        op = Reports()
+        job = op._prepare(bpy.context, solver)
+        token = solver.CancelToken()
+        seen = []
+
+        def progress(p):
+            seen.append(dict(p))
+            job.progress.update(p)
+            if p.get("pass", 0) >= cancel_at_pass:
+                token.cancel()
+
+        if cancel_at_pass == 0:
+            token.cancel()
+
+        def work():
+            try:
+                job.result = solver.solve(job.native_scene, progress=progress, cancel=token, **job.options)
+            except BaseException as err:
+                job.error = err
+
+        thread = threading.Thread(target=work)
+        thread.start()
+        thread.join(120)
+        self.assertFalse(thread.is_alive())
+        return scene, op, job, op._conclude(bpy.context, job), seen
+
+    def test_cancel_keeps_last_complete_pass(self):
+        scene, op, job, result, seen = self.run_worker(cancel_at_pass=2)
+        self.assertEqual(result, {'FINISHED'}, op.reports)
+        self.assertTrue(job.result.stats["cancelled"])
+        self.assertEqual(scene.radiosity.stats.status, "Cancelled (last complete pass kept)")
+        self.assertTrue(seen)
+        for obj in bake.result_objects(scene):
+            values = attribute(obj)
+            self.assertTrue(np.all(np.isfinite(values)) and np.all(values >= 0))
+        self.assertEqual(len(bake.result_objects(scene)), 8)
+
+    def test_cancel_before_first_pass_changes_nothing(self):
+        scene, op, job, result, _ = self.run_worker(cancel_at_pass=0)
+        self.assertEqual(result, {'CANCELLED'})
+        self.assertIn("cancelled before the first pass", op.reports[-1][1])
+        self.assertEqual(scene_snapshot(scene), self.before)
+
+
+class CommandLineTest(unittest.TestCase):
+    def test_background_python_expr(self):
+        # The add-on enabled the way a user's Blender has it: found in a user
+        # scripts folder (BLENDER_USER_SCRIPTS/addons/radiosity) and enabled
+        # with --addons; then the documented one-liner.
+        path = build_file("cube")
+        with tempfile.TemporaryDirectory() as scripts:
+            os.makedirs(os.path.join(scripts, "addons"))
+            os.symlink(os.path.join(ADDON_DIR, "radiosity"), os.path.join(scripts, "addons", "radiosity"))
+            out = os.path.join(scripts, "solved.blend")
+            expr = ("import bpy; bpy.ops.radiosity.solve(); "
+                    "bpy.ops.wm.save_as_mainfile(filepath=%r)" % out)
+            env = dict(os.environ, BLENDER_USER_SCRIPTS=scripts)
+            proc = subprocess.run([bpy.app.binary_path, "-b", "--factory-startup", "--addons", "radiosity",
+                                   path, "--python-exit-code", "1", "--python-expr", expr],
+                                  env=env, capture_output=True, text=True, timeout=300)
+            self.assertEqual(proc.returncode, 0, proc.stdout[-2000:] + proc.stderr[-2000:])
+            self.assertTrue(os.path.exists(out))
+            bpy.ops.wm.open_mainfile(filepath=out)
+        scene = bpy.context.scene
+        self.assertEqual(len(bake.result_objects(scene)), 8)
+        self.assertTrue(scene.radiosity.stats.valid)
+
+
+if __name__ == "__main__":
+    unittest.main()
