@@ -48,7 +48,7 @@ def solve(scene, oracle):
     except RuntimeError as err:
         # The operator reports errors; bpy.ops raises them as RuntimeError.
         say("solve not done: %s" % str(err).strip().removeprefix("Error: "))
-        say("the solver is not available yet: rendering the unsolved scene (path traced)")
+        say("rendering the unsolved scene (path traced)")
         return False
     if result != {'FINISHED'}:
         say("solve %s; rendering the unsolved scene" % ", ".join(sorted(result)).lower())
@@ -60,9 +60,12 @@ def solve(scene, oracle):
 
 
 def render(scene, path, samples):
-    # Quick on two cores: few samples, no denoiser (not in every Blender build),
-    # and indirect light clamped so that few samples show no fireflies. This
-    # changes only the preview render: the saved .blend keeps the scene's settings.
+    # After a solve the camera sees only the result meshes, whose material
+    # emits the baked radiance: no light transport left, so a few samples (for
+    # anti-aliasing) give a noise-free image. Unsolved, it is a quick path-traced
+    # preview: no denoiser (not in every Blender build), indirect light clamped
+    # against fireflies. This changes only the preview render: the saved .blend
+    # keeps the scene's settings.
     scene.cycles.samples = samples
     scene.cycles.use_denoising = False
     scene.cycles.sample_clamp_indirect = 1.0
@@ -75,11 +78,22 @@ def render(scene, path, samples):
         % (scene.render.resolution_x, scene.render.resolution_y, samples, time.perf_counter() - start))
 
 
+def show_result_in_viewport(scene):
+    """Solid shading shows the attribute; the saved file opens on the solution."""
+    for screen in bpy.data.screens:
+        for area in screen.areas:
+            for space in area.spaces:
+                if space.type == 'VIEW_3D':
+                    space.shading.type = 'SOLID'
+                    space.shading.light = 'FLAT'   # the colours are the lighting
+
+
 def main():
     args = parse_args()
     enable_addon(args.addon)
     scene = bpy.context.scene
-    solve(scene, args.oracle)
+    if solve(scene, args.oracle):
+        show_result_in_viewport(scene)
     bpy.ops.wm.save_as_mainfile(filepath=args.blend)
     render(scene, args.png, args.samples)
 
