@@ -87,6 +87,14 @@ bool receiver_in_front(const dvec3& r, std::span<const Vertex> polygon) {
   return height > 1e-12 * diameter + rounding;
 }
 
+// Height of a vertex above the receiver's horizon; a vertex below it only by
+// rounding counts as on it, so no sliver piece is clipped off.
+double horizon_height(const dvec3& r, const dvec3& n, const dvec3& p) {
+  const dvec3 d = p - r;
+  const double h = glm::dot(n, d);
+  return h < 0.0 && h > -1e-14 * glm::length(d) ? 0.0 : h;
+}
+
 // Sutherland-Hodgman clip to the receiver's upper half-space n.(x - r) >= 0.
 // Returns the vertex count written to `out` (room for 2n vertices).
 template <class Vertex>
@@ -96,8 +104,8 @@ size_t clip_to_horizon(const dvec3& r, const dvec3& n, std::span<const Vertex> i
   for (size_t i = 0; i < size; ++i) {
     const Vertex& a = in[i];
     const Vertex& b = in[(i + 1) % size];
-    const double ha = glm::dot(n, position_of(a) - r);
-    const double hb = glm::dot(n, position_of(b) - r);
+    const double ha = horizon_height(r, n, position_of(a));
+    const double hb = horizon_height(r, n, position_of(b));
     if (ha >= 0.0) out[count++] = a;
     if ((ha >= 0.0) != (hb >= 0.0)) {
       const double t = ha / (ha - hb);
@@ -114,7 +122,7 @@ template <class Vertex, class Integrate>
 auto with_horizon_clip(const dvec3& r, const dvec3& n, std::span<const Vertex> polygon,
                        Integrate&& integrate) {
   bool below = false;
-  for (const Vertex& v : polygon) below |= glm::dot(n, position_of(v) - r) < 0.0;
+  for (const Vertex& v : polygon) below |= horizon_height(r, n, position_of(v)) < 0.0;
   if (!below) return integrate(polygon);
   PolygonBuffer<Vertex> buffer(2 * polygon.size());
   const size_t count = clip_to_horizon(r, n, polygon, buffer.data());
@@ -213,9 +221,12 @@ dvec3 vertex_jacobian_transpose_times(const ContourVertex& v, const dvec3& r, co
     // through r and the edge's 3D line (P, d): dm = d x dr, so
     // J^T g = d x (n x g_tangent) / |w|, oriented so that u points at the vertex.
     const dvec3& d = v.s.direction;
-    const dvec3 w = glm::cross(n, glm::cross(v.s.point - r, d));
+    const dvec3 m = glm::cross(v.s.point - r, d);
+    const dvec3 w = glm::cross(n, m);
     const double length = glm::length(w);
-    if (!(length > 0.0)) return dvec3(0.0);
+    // An edge lying along the horizon: its plane is the tangent plane and the
+    // crossing is ill-defined; the vertex then moves like a fixed point.
+    if (!(length > 1e-9 * glm::length(m))) return -g_tangent / glm::length(v.position - r);
     const double sign = glm::dot(w, u) >= 0.0 ? 1.0 : -1.0;
     return sign * glm::cross(d, glm::cross(n, g_tangent)) / length;
   }

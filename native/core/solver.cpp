@@ -85,6 +85,9 @@ class Solver {
   const double reference_radiance_;
   const double min_area_;
   std::vector<Link> links_;
+  // Links grouped by receiver for the gather, and which links they describe.
+  std::vector<std::uint32_t> offset_, order_;
+  std::uint64_t links_version_ = 1, grouped_version_ = 0;
   SolveResult result_;     // the last complete pass
   bool have_result_ = false;
   bool budget_hit_ = false;
@@ -184,6 +187,7 @@ void Solver::link_initially() {
     report("linking", 0.1 * static_cast<double>(end) / static_cast<double>(receivers.size()));
   }
   for (const Link& l : links_) hierarchy_.element(l.receiver).has_links = 1;
+  ++links_version_;
   stats_.seconds_linking = std::chrono::duration<double>(Clock::now() - start).count();
   track_memory();
 }
@@ -237,6 +241,25 @@ bool Solver::refine(double threshold) {
       }
       kept.push_back(link);
     }
+    if (options_.links_at_leaves) {
+      // A split receiver hands all its links down, so every sample's value is
+      // gathered exactly, never interpolated from a coarser element.
+      std::vector<Link> staying;
+      for (const Link& link : kept) {
+        const Element& receiver = hierarchy_.element(link.receiver);
+        if (receiver.is_leaf()) {
+          staying.push_back(link);
+          continue;
+        }
+        for (std::int32_t c = receiver.first_child; c < receiver.first_child + 4; ++c) {
+          Link l;
+          l.receiver = c;
+          l.emitter = link.emitter;
+          fresh.push_back(l);
+        }
+      }
+      kept = std::move(staying);
+    }
     if (fresh.empty()) break;
     changed = true;
     std::vector<Link> made = evaluate_links(std::move(fresh));
@@ -244,6 +267,7 @@ bool Solver::refine(double threshold) {
     for (const Link& l : made) hierarchy_.element(l.receiver).has_links = 1;
     kept.insert(kept.end(), made.begin(), made.end());
     links_ = std::move(kept);
+    ++links_version_;
     track_memory();
     report("refining", (pass_ + 0.5) / (passes_ + 1.0));
   }
@@ -254,15 +278,19 @@ bool Solver::refine(double threshold) {
 void Solver::gather() {
   auto& elements = hierarchy_.elements();
   for (Element& e : elements) e.gathered.fill(Rgb(0.0));
-  // Group links by receiver (counting sort keeps link order within a receiver).
-  std::vector<std::uint32_t> offset(elements.size() + 1, 0);
-  for (const Link& l : links_) ++offset[static_cast<size_t>(l.receiver) + 1];
-  for (size_t i = 1; i < offset.size(); ++i) offset[i] += offset[i - 1];
-  std::vector<std::uint32_t> order(links_.size());
-  {
-    std::vector<std::uint32_t> next(offset.begin(), offset.end() - 1);
-    for (std::uint32_t i = 0; i < links_.size(); ++i) order[next[static_cast<size_t>(links_[i].receiver)]++] = i;
+  // Group links by receiver (counting sort keeps link order within a
+  // receiver); rebuilt only when refinement changed the links.
+  if (links_version_ != grouped_version_) {
+    offset_.assign(elements.size() + 1, 0);
+    for (const Link& l : links_) ++offset_[static_cast<size_t>(l.receiver) + 1];
+    for (size_t i = 1; i < offset_.size(); ++i) offset_[i] += offset_[i - 1];
+    order_.resize(links_.size());
+    std::vector<std::uint32_t> next(offset_.begin(), offset_.end() - 1);
+    for (std::uint32_t i = 0; i < links_.size(); ++i) order_[next[static_cast<size_t>(links_[i].receiver)]++] = i;
+    grouped_version_ = links_version_;
   }
+  const auto& offset = offset_;
+  const auto& order = order_;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, elements.size()), [&](const auto& range) {
     for (size_t e = range.begin(); e != range.end(); ++e) {
       std::array<glm::dvec3, kMaxSamples> h{};
@@ -332,8 +360,16 @@ double Solver::push_pull() { return push_pull_all(hierarchy_, nullptr); }
 // last residual.
 double Solver::iterate(double threshold, int max_iterations, double tolerance) {
   double residual = 0.0;
+  // Radiance change since refinement last found nothing to do: decisions can
+  // only change once the radiances they read have moved (a converging
+  // high-albedo scene iterates hundreds of times without new refinement).
+  double drift = std::numeric_limits<double>::infinity();
   for (int i = 0; i < max_iterations && !cancelled(); ++i) {
-    const bool refined = refine(threshold);
+    bool refined = false;
+    if (drift > 1e-3) {
+      refined = refine(threshold);
+      drift = refined ? std::numeric_limits<double>::infinity() : 0.0;
+    }
     if (cancelled()) break;
     const auto start = Clock::now();
     gather();
@@ -341,6 +377,7 @@ double Solver::iterate(double threshold, int max_iterations, double tolerance) {
     stats_.seconds_gather += std::chrono::duration<double>(Clock::now() - start).count();
     ++stats_.iterations;
     stats_.residual = residual;
+    if (std::isfinite(drift)) drift += residual;
     if (!refined && residual < tolerance) break;
     if (out_of_time() && !refined && i > 0 && residual < 1e3 * tolerance) break;
   }

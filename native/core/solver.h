@@ -34,6 +34,9 @@ struct SolveOptions {
   // Smallest element, as a fraction of the scene's total area (1e-5 of an
   // 80 m2 room is a 3 cm square).
   double min_element_area = 1e-5;
+  // Links end on leaves: a split receiver hands all its links to its children,
+  // instead of pushing interpolated values down (see DESIGN notes in README).
+  bool links_at_leaves = true;
   double tolerance = 1e-6;  // relative change of radiance that counts as converged
   int max_iterations = 5000;
 };

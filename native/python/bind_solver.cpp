@@ -172,7 +172,7 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
                   std::optional<std::int64_t> max_elements, std::optional<double> time_budget,
                   const std::string& visibility, int rays, std::optional<int> bounces,
                   std::optional<int> threads, const py::object& progress,
-                  const py::object& cancel, double min_element_area) {
+                  const py::object& cancel, double min_element_area, bool links_at_leaves) {
   SolveOptions options;
   options.oracle = read_oracle(oracle);
   options.quality = quality;
@@ -186,6 +186,7 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
   options.bounces = bounces;
   options.threads = threads;
   options.min_element_area = min_element_area;
+  options.links_at_leaves = links_at_leaves;
 
   const CancelToken* token = nullptr;
   if (!cancel.is_none()) {
@@ -275,7 +276,7 @@ void bind_solver(py::module_& m) {
         py::arg("time_budget") = py::none(), py::arg("visibility") = "exact", py::arg("rays") = 16,
         py::arg("bounces") = py::none(), py::arg("threads") = py::none(),
         py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
-        py::arg("min_element_area") = 1e-5,
+        py::arg("min_element_area") = 1e-5, py::arg("links_at_leaves") = true,
         "Hierarchical radiosity. oracle: 'standard' | 'perceptual' | 'gradient'; quality in\n"
         "[0, 1] (0: no refinement); max_elements, time_budget (s): budgets; visibility:\n"
         "'exact' | 'sampled' (rays per sample); bounces: fixed iteration count instead of\n"

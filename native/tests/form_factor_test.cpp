@@ -501,3 +501,28 @@ TEST(FormFactorGradient, TreatingApparentAsIntrinsicIsMeasurablyWrong) {
 
 }  // namespace
 }  // namespace radiosity
+
+namespace radiosity {
+namespace {
+
+TEST(FormFactorGradient, EdgeAlongTheHorizonStaysFinite) {
+  // A visible piece with one vertex 1e-16 below the horizon (rounding): its
+  // horizon crossing lies on an edge in the tangent plane (found by the
+  // visibility tests).
+  const dvec3 r(0.22486601452516758, -0.27562196932356731, 0);
+  const dvec3 n(0.75645498309883608, -0.57279740863576667, 0.31571979222894847);
+  const std::vector<ContourVertex> piece = {
+      ContourVertex::intrinsic({-0.39369216399755957, 0.0098684423165902313, 2},
+                               {0.026810438532263781, -0.18421105620156888, 0.64037816609558185}),
+      ContourVertex::intrinsic({-0.36018376613390019, 0.054120727954533265, 2},
+                               {0.037539461718629458, -0.170041957440387, 0.64037816609558185}),
+      ContourVertex::intrinsic({-0.36018376613390024, 0.0098684423165902313, 2},
+                               {0.037539461718629458, -0.18421105620156888, 0.64037816609558185}),
+  };
+  const auto result = form_factor_gradient(r, glm::normalize(n), piece);
+  EXPECT_TRUE(std::isfinite(result.value));
+  EXPECT_LT(glm::length(result.gradient), 1.0);
+}
+
+}  // namespace
+}  // namespace radiosity

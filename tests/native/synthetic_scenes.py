@@ -18,8 +18,9 @@ class SceneBuilder:
         self.two_sided.append(two_sided)
         return len(self.faces) - 1
 
-    def box(self, lo, hi, rho=(0.5, 0.5, 0.5), emission=(0, 0, 0), inward=False):
-        """Six quads of an axis-aligned box, facing out (or in, for a room)."""
+    def box(self, lo, hi, rho=(0.5, 0.5, 0.5), emission=(0, 0, 0), inward=False, skip=()):
+        """Six quads of an axis-aligned box, facing out (or in, for a room);
+        `skip` leaves out sides by index (0 bottom, 1 top, 2 -y, 3 +y, 4 -x, 5 +x)."""
         x0, y0, z0 = lo
         x1, y1, z1 = hi
         quads = [
@@ -31,8 +32,9 @@ class SceneBuilder:
             [(x1, y0, z0), (x1, y1, z0), (x1, y1, z1), (x1, y0, z1)],  # +x
         ]
         faces = []
-        for q in quads:
-            faces.append(self.polygon(q[::-1] if inward else q, rho, emission))
+        for k, q in enumerate(quads):
+            if k not in skip:
+                faces.append(self.polygon(q[::-1] if inward else q, rho, emission))
         return faces
 
     def arrays(self):
