@@ -123,7 +123,8 @@ class RADIOSITY_OT_solve(Operator):
             self._token.cancel()
             context.workspace.status_text_set("Radiosity: cancelling, keeping the last complete pass")
             return {'RUNNING_MODAL'}
-        if event.type == 'TIMER' and event.timer is self._timer:
+        # Any timer tick will do (other timers tick too; checking is cheap).
+        if event.type == 'TIMER':
             if self._thread.is_alive():
                 progress = dict(self._job.progress)
                 context.window_manager.progress_update(100.0 * float(progress.get("fraction", 0.0)))
