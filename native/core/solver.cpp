@@ -243,22 +243,29 @@ bool Solver::refine(double threshold) {
     }
     if (options_.links_at_leaves) {
       // A split receiver hands all its links down, so every sample's value is
-      // gathered exactly, never interpolated from a coarser element.
-      std::vector<Link> staying;
-      for (const Link& link : kept) {
-        const Element& receiver = hierarchy_.element(link.receiver);
-        if (receiver.is_leaf()) {
-          staying.push_back(link);
-          continue;
+      // gathered exactly, never interpolated from a coarser element. Fresh
+      // links too: their receiver may have been split by another link.
+      const auto hand_down = [&](std::vector<Link>& links, std::vector<Link>& staying,
+                                 std::vector<Link>& moved) {
+        for (const Link& link : links) {
+          const Element& receiver = hierarchy_.element(link.receiver);
+          if (receiver.is_leaf()) {
+            staying.push_back(link);
+            continue;
+          }
+          for (std::int32_t c = receiver.first_child; c < receiver.first_child + 4; ++c) {
+            Link l;
+            l.receiver = c;
+            l.emitter = link.emitter;
+            moved.push_back(l);
+          }
         }
-        for (std::int32_t c = receiver.first_child; c < receiver.first_child + 4; ++c) {
-          Link l;
-          l.receiver = c;
-          l.emitter = link.emitter;
-          fresh.push_back(l);
-        }
-      }
+      };
+      std::vector<Link> staying, fresh_leaves;
+      hand_down(kept, staying, fresh);
+      hand_down(fresh, fresh_leaves, fresh_leaves);
       kept = std::move(staying);
+      fresh = std::move(fresh_leaves);
     }
     if (fresh.empty()) break;
     changed = true;
@@ -378,7 +385,8 @@ double Solver::iterate(double threshold, int max_iterations, double tolerance) {
     ++stats_.iterations;
     stats_.residual = residual;
     if (std::isfinite(drift)) drift += residual;
-    if (!refined && residual < tolerance) break;
+    // A pass cut short by the element budget is the last: converge it fully.
+    if (!refined && residual < (budget_hit_ ? options_.tolerance : tolerance)) break;
     if (out_of_time() && !refined && i > 0 && residual < 1e3 * tolerance) break;
   }
   return residual;

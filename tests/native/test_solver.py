@@ -70,8 +70,10 @@ class Furnace(unittest.TestCase):
         for rho in (0.5, 0.9, 0.99):
             for oracle in ORACLES:
                 with self.subTest(rho=rho, oracle=oracle):
-                    result = rad.solve(closed_box(rho, 0.7).scene(rad), oracle=oracle, quality=0.5)
-                    self.assertGreater(result.stats["elements"], 12)
+                    # A budget keeps the high-albedo cases (~900 iterations) quick.
+                    result = rad.solve(closed_box(rho, 0.7).scene(rad), oracle=oracle, quality=0.5,
+                                       max_elements=1500)
+                    self.assertGreater(result.stats["elements"], 200)
                     np.testing.assert_allclose(result.radiance, 0.7 / (1 - rho), rtol=1e-3)
 
     def test_pushing_interpolated_values_is_measurably_worse(self):
