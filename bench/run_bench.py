@@ -1,0 +1,45 @@
+#!/usr/bin/env python3
+"""`make bench`: the benchmarks that exist so far, in one run.
+
+    /usr/bin/python3 bench/run_bench.py --build build [--quick]
+
+1. Google Benchmark programs of the native core (kernels, visibility): median
+   of repetitions, JSON in <build>/bench/<program>.json.
+2. The solver sweep (bench/solver_bench.py): elements, links, time and memory
+   per oracle and quality, CSV in <build>/bench/solver.csv.
+
+The speed-accuracy study of issue 7 (renders, error metric, plots, report)
+will be added here.
+"""
+
+import argparse
+import pathlib
+import subprocess
+import sys
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--build", default="build")
+    parser.add_argument("--blender", default="blender", help="unused until the render study lands")
+    parser.add_argument("--quick", action="store_true", help="fewer repetitions and sweep points")
+    args = parser.parse_args()
+    out = ROOT / args.build / "bench"
+    out.mkdir(parents=True, exist_ok=True)
+    repetitions = "3" if args.quick else "9"
+    for program in ("kernels_bench", "visibility_bench"):
+        exe = ROOT / args.build / "bench" / program
+        print(f"== {program}", flush=True)
+        subprocess.run([str(exe), f"--benchmark_repetitions={repetitions}", "--benchmark_report_aggregates_only=true",
+                        f"--benchmark_out={out / (program + '.json')}", "--benchmark_out_format=json"]
+                       + (["--benchmark_min_time=0.05"] if args.quick else []), check=True)
+    print("== solver", flush=True)
+    command = [sys.executable, str(ROOT / "bench" / "solver_bench.py"), "--build", args.build]
+    command += ["--quick", "--repeats", "1"] if args.quick else ["--faces", "1000"]
+    subprocess.run(command, check=True)
+
+
+if __name__ == "__main__":
+    main()
