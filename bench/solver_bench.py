@@ -73,7 +73,8 @@ def measure(rad, builder, oracle, quality, repeats, **options):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--build", default="build")
-    parser.add_argument("--faces", type=int, default=10000)
+    parser.add_argument("--faces", type=int, default=1000,
+                        help="faces of the generated scene (initial linking grows as faces^2.2)")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--quick", action="store_true", help="fewer points, smaller generated scene")
     args = parser.parse_args()
