@@ -111,22 +111,31 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings) const {
 
   // A receiver sample at an emitter vertex (elements meeting at a corner) sees a
   // value that depends on the direction of approach, and a gradient that grows
-  // without bound as the sample nears the vertex (MATH.md s3). Its value is
-  // kept; its slope says nothing about the element, so it counts as flat.
+  // without bound as the sample nears the vertex (MATH.md s3): no element size
+  // makes the radiance linear there, so the oracle judges the element by its
+  // other samples. (The sample still gathers: links end on leaves, so its value
+  // is exact for the output.)
   start = Clock::now();
   const double contact = 1e-5 * hierarchy.diameter(receiver);
+  dvec3 oracle_x[kMaxSamples], oracle_grad[kMaxSamples];
+  double oracle_value[kMaxSamples];
+  size_t used = 0;
   for (int s = 0; s < ns; ++s) {
-    for (int k = 0; k < ne; ++k) {
-      if (glm::length(x[s] - emitter_corners[k]) < contact) grad[s] = dvec3(0.0);
-    }
+    bool at_vertex = false;
+    for (int k = 0; k < ne; ++k) at_vertex |= glm::length(x[s] - emitter_corners[k]) < contact;
+    if (at_vertex) continue;
+    oracle_x[used] = x[s];
+    oracle_value[used] = value[s];
+    oracle_grad[used] = grad[s];
+    ++used;
   }
-  LinkSamples samples{std::span<const dvec3>(x, static_cast<size_t>(ns)),
-                      std::span<const double>(value, static_cast<size_t>(ns)),
-                      std::span<const dvec3>(grad, static_cast<size_t>(ns)),
+  LinkSamples samples{std::span<const dvec3>(oracle_x, used),
+                      std::span<const double>(oracle_value, used),
+                      std::span<const dvec3>(oracle_grad, used),
                       n,
-                      static_cast<double>(receiver.area),
+                      receiver.area,
                       hierarchy.diameter(receiver)};
-  link.oracle = static_cast<float>(oracle_geometry(oracle, samples) / geometric_scale);
+  link.oracle = used >= 2 ? static_cast<float>(oracle_geometry(oracle, samples) / geometric_scale) : 0.0f;
   timings.oracle += seconds_since(start);
   return true;
 }

@@ -67,6 +67,7 @@ class Solver {
   bool refine(double threshold);
   Split choose_split(const Link& link, double threshold) const;
   bool can_split(std::int32_t e) const { return hierarchy_.element(e).area / 4.0 >= min_area_; }
+  bool near_field(const Link& link) const;
   void gather();
   double push_pull();
   double iterate(double threshold, int max_iterations, double tolerance);
@@ -192,6 +193,18 @@ void Solver::link_initially() {
   track_memory();
 }
 
+// An emitter closer to the receiver than the receiver's own size: the form
+// factor may vary between the receiver's samples in ways its interpolant
+// cannot follow (it grows quickly towards a shared edge), so such links follow
+// a split receiver down instead of being interpolated.
+bool Solver::near_field(const Link& link) const {
+  const Element& p = hierarchy_.element(link.receiver);
+  const Element& q = hierarchy_.element(link.emitter);
+  const double rp = 0.5 * hierarchy_.diameter(p), rq = 0.5 * hierarchy_.diameter(q);
+  const double gap = glm::length(hierarchy_.centre(p) - hierarchy_.centre(q)) - rp - rq;
+  return gap < 2.0 * rp;
+}
+
 // The refinement policy shared by every oracle (DESIGN s5): split the larger
 // of receiver and emitter unless it is at the minimum size, then the other.
 Split Solver::choose_split(const Link& link, double threshold) const {
@@ -241,7 +254,7 @@ bool Solver::refine(double threshold) {
       }
       kept.push_back(link);
     }
-    if (options_.links_at_leaves) {
+    if (options_.leaf_links != SolveOptions::LeafLinks::None) {
       // A split receiver hands all its links down, so every sample's value is
       // gathered exactly, never interpolated from a coarser element. Fresh
       // links too: their receiver may have been split by another link.
@@ -249,7 +262,8 @@ bool Solver::refine(double threshold) {
                                  std::vector<Link>& moved) {
         for (const Link& link : links) {
           const Element& receiver = hierarchy_.element(link.receiver);
-          if (receiver.is_leaf()) {
+          if (receiver.is_leaf() ||
+              (options_.leaf_links == SolveOptions::LeafLinks::Near && !near_field(link))) {
             staying.push_back(link);
             continue;
           }

@@ -172,7 +172,7 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
                   std::optional<std::int64_t> max_elements, std::optional<double> time_budget,
                   const std::string& visibility, int rays, std::optional<int> bounces,
                   std::optional<int> threads, const py::object& progress,
-                  const py::object& cancel, double min_element_area, bool links_at_leaves) {
+                  const py::object& cancel, double min_element_area, const std::string& leaf_links) {
   SolveOptions options;
   options.oracle = read_oracle(oracle);
   options.quality = quality;
@@ -186,7 +186,15 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
   options.bounces = bounces;
   options.threads = threads;
   options.min_element_area = min_element_area;
-  options.links_at_leaves = links_at_leaves;
+  if (leaf_links == "none") {
+    options.leaf_links = SolveOptions::LeafLinks::None;
+  } else if (leaf_links == "near") {
+    options.leaf_links = SolveOptions::LeafLinks::Near;
+  } else if (leaf_links == "all") {
+    options.leaf_links = SolveOptions::LeafLinks::All;
+  } else {
+    throw std::invalid_argument("leaf_links must be 'none', 'near' or 'all', got '" + leaf_links + "'");
+  }
 
   const CancelToken* token = nullptr;
   if (!cancel.is_none()) {
@@ -276,11 +284,12 @@ void bind_solver(py::module_& m) {
         py::arg("time_budget") = py::none(), py::arg("visibility") = "exact", py::arg("rays") = 16,
         py::arg("bounces") = py::none(), py::arg("threads") = py::none(),
         py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
-        py::arg("min_element_area") = 1e-5, py::arg("links_at_leaves") = true,
+        py::arg("min_element_area") = 1e-5, py::arg("leaf_links") = "near",
         "Hierarchical radiosity. oracle: 'standard' | 'perceptual' | 'gradient'; quality in\n"
         "[0, 1] (0: no refinement); max_elements, time_budget (s): budgets; visibility:\n"
         "'exact' | 'sampled' (rays per sample); bounces: fixed iteration count instead of\n"
-        "convergence; threads; progress(dict) callback; cancel: CancelToken.");
+        "convergence; threads; progress(dict) callback; cancel: CancelToken;\n"
+        "leaf_links: 'near' | 'all' | 'none', which links follow a split receiver down.");
   m.def("quality_threshold", [](const std::string& oracle, double quality) {
     return quality_threshold(read_oracle(oracle), quality);
   }, py::arg("oracle"), py::arg("quality"), "The oracle's refinement threshold at a quality level.");
