@@ -8,6 +8,7 @@ packages=(
   python3 python3-dev python3-numpy python3-matplotlib
   pybind11-dev libglm-dev libopenimageio-dev libembree-dev libtbb-dev
   libgtest-dev libbenchmark-dev
+  xvfb libgl1-mesa-dri  # the interactive (modal, ESC) test runs Blender in a virtual display
 )
 
 missing=()

@@ -84,7 +84,9 @@ Rgb Interpolant::at_child_sample(int corner_count, const std::array<Rgb, kMaxSam
   const double* w = child_weights().w[corner_count == 4 ? 1 : 0][c][s];
   glm::dvec3 sum(0.0);
   for (int k = 0; k <= corner_count; ++k) sum += w[k] * glm::dvec3(values[static_cast<size_t>(k)]);
-  return Rgb(sum);
+  // The bubble can overshoot below zero where the centre is much darker than
+  // the corners; gathered light is never negative.
+  return glm::max(Rgb(sum), Rgb(0.0));
 }
 
 Rgb Interpolant::average(int corner_count, const std::array<Rgb, kMaxSamples>& values) {

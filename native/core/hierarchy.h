@@ -94,7 +94,8 @@ class Hierarchy {
 // barycentric through the corners plus a bubble that vanishes on the edges and
 // matches the centre sample. Continuous across edges.
 struct Interpolant {
-  // Value at child `c`'s sample `s` of a parent with `corner_count` corners.
+  // Value at child `c`'s sample `s` of a parent with `corner_count` corners
+  // (clamped at zero).
   static Rgb at_child_sample(int corner_count, const std::array<Rgb, kMaxSamples>& values, int c,
                              int s);
   // Area average of the interpolant (the weights that integrate it exactly in

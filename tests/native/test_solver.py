@@ -294,6 +294,7 @@ class Cancellation(unittest.TestCase):
         self.assertTrue(result.stats["cancelled"])
         self.assertEqual(result.stats["stopped_by"], "cancel")
         self.assertTrue(np.all(np.isfinite(result.radiance)))
+        self.assertTrue(np.all(result.radiance >= 0))
         self.assertEqual(result.face_vertices.size, result.face_sizes.sum())
         self.assertLess(result.face_vertices.max(), len(result.positions))
         self.assertGreater(result.radiance.max(), 0)
@@ -306,6 +307,20 @@ class Cancellation(unittest.TestCase):
 
         with self.assertRaises(KeyError):
             rad.solve(b.scene(rad), quality=0.3, progress=progress)
+
+    def test_every_pass_snapshot_is_finite_and_non_negative(self):
+        b, _ = room_with_blocker()
+        for oracle in ORACLES:
+            for cancel_at in (1, 2, 3):
+                token = rad.CancelToken()
+
+                def progress(p):
+                    if p["pass"] >= cancel_at:
+                        token.cancel()
+
+                result = rad.solve(b.scene(rad), oracle=oracle, quality=1.0, progress=progress, cancel=token)
+                self.assertTrue(np.all(np.isfinite(result.radiance)))
+                self.assertGreaterEqual(result.radiance.min(), 0.0, (oracle, cancel_at))
 
     def test_progress_is_reported_per_pass(self):
         b, _ = room_with_blocker()
