@@ -28,37 +28,12 @@ struct CancelToken {
   std::atomic<bool> flag{false};
 };
 
-template <class T>
-using Array = py::array_t<T, py::array::c_style | py::array::forcecast>;
-
-template <class T>
-Array<T> read_typed(const py::handle& object, const std::string& name, std::vector<py::ssize_t> shape) {
-  if (object.is_none()) throw std::invalid_argument(name + " must be an array, got None");
-  Array<T> a;
-  try {
-    a = Array<T>::ensure(object);
-  } catch (const py::error_already_set&) {
-    a = {};
-  }
-  if (!a) throw std::invalid_argument(name + " must be convertible to a numeric array");
-  bool ok = a.ndim() == static_cast<py::ssize_t>(shape.size());
-  for (size_t i = 0; ok && i < shape.size(); ++i) {
-    ok = shape[i] < 0 || a.shape(static_cast<py::ssize_t>(i)) == shape[i];
-  }
-  if (!ok) {
-    std::string got = "(";
-    for (py::ssize_t i = 0; i < a.ndim(); ++i) got += (i ? ", " : "") + std::to_string(a.shape(i));
-    throw std::invalid_argument(name + " has the wrong shape " + got + (a.ndim() == 1 ? ",)" : ")"));
-  }
-  return a;
-}
-
 // Integer input must hold integers: a float array is accepted only if whole.
-Array<std::int64_t> read_indices(const py::handle& object, const std::string& name) {
+InputArray<std::int64_t> read_indices(const py::handle& object, const std::string& name) {
   if (!object.is_none()) {
     const auto as_array = py::array::ensure(object);
     if (as_array && as_array.dtype().kind() == 'f') {
-      const auto floats = read_typed<double>(object, name, {-1});
+      const auto floats = read_array_of<double>(object, name, {-1});
       for (py::ssize_t i = 0; i < floats.size(); ++i) {
         const double v = floats.data()[i];
         if (!std::isfinite(v) || v != std::floor(v)) {
@@ -67,20 +42,20 @@ Array<std::int64_t> read_indices(const py::handle& object, const std::string& na
       }
     }
   }
-  return read_typed<std::int64_t>(object, name, {-1});
+  return read_array_of<std::int64_t>(object, name, {-1});
 }
 
 Scene make_python_scene(const py::handle& positions, const py::handle& face_vertices,
                         const py::handle& face_sizes, const py::handle& reflectance,
                         const py::handle& emission, const py::handle& two_sided) {
-  const auto p = read_typed<double>(positions, "positions", {-1, 3});
+  const auto p = read_array_of<double>(positions, "positions", {-1, 3});
   const auto fv = read_indices(face_vertices, "face_vertices");
   const auto fs = read_indices(face_sizes, "face_sizes");
   const auto faces = fs.shape(0);
-  const auto rho = read_typed<double>(reflectance, "reflectance", {faces, 3});
-  const auto le = read_typed<double>(emission, "emission", {faces, 3});
-  Array<std::uint8_t> sided;
-  if (!two_sided.is_none()) sided = read_typed<std::uint8_t>(two_sided, "two_sided", {faces});
+  const auto rho = read_array_of<double>(reflectance, "reflectance", {faces, 3});
+  const auto le = read_array_of<double>(emission, "emission", {faces, 3});
+  InputArray<std::uint8_t> sided;
+  if (!two_sided.is_none()) sided = read_array_of<std::uint8_t>(two_sided, "two_sided", {faces});
   SceneArrays arrays;
   arrays.positions = {p.data(), static_cast<size_t>(p.size())};
   arrays.face_vertices = {fv.data(), static_cast<size_t>(fv.size())};

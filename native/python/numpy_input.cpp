@@ -30,16 +30,7 @@ std::string expected_string(const std::vector<py::ssize_t>& shape) {
 
 }  // namespace
 
-py::array_t<double, py::array::c_style | py::array::forcecast> read_array(
-    const py::handle& object, const std::string& name, std::vector<py::ssize_t> shape) {
-  if (object.is_none()) throw std::invalid_argument(name + " must be an array, got None");
-  py::array_t<double, py::array::c_style | py::array::forcecast> a;
-  try {
-    a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(object);
-  } catch (const py::error_already_set&) {
-    a = {};
-  }
-  if (!a) throw std::invalid_argument(name + " must be convertible to a float64 array");
+void require_shape(const py::array& a, const std::string& name, const std::vector<py::ssize_t>& shape) {
   bool ok = a.ndim() == static_cast<py::ssize_t>(shape.size());
   for (size_t i = 0; ok && i < shape.size(); ++i) {
     ok = shape[i] < 0 || a.shape(static_cast<py::ssize_t>(i)) == shape[i];
@@ -48,6 +39,11 @@ py::array_t<double, py::array::c_style | py::array::forcecast> read_array(
     throw std::invalid_argument(name + " must have shape " + expected_string(shape) + ", got " +
                                 shape_string(a));
   }
+}
+
+InputArray<double> read_array(const py::handle& object, const std::string& name,
+                              const std::vector<py::ssize_t>& shape) {
+  auto a = read_array_of<double>(object, name, shape);
   require_finite(a.data(), static_cast<size_t>(a.size()), name);
   return a;
 }

@@ -6,6 +6,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -13,10 +14,33 @@
 
 namespace radiosity::python {
 
-// A float64 C-contiguous array of the given rank whose trailing dimensions match
-// `trailing` (-1 = any); the leading one is free. Converts lists and other dtypes.
-pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast> read_array(
-    const pybind11::handle& object, const std::string& name, std::vector<pybind11::ssize_t> shape);
+template <class T>
+using InputArray = pybind11::array_t<T, pybind11::array::c_style | pybind11::array::forcecast>;
+
+// Throws unless `a` has `shape` (-1: any size on that axis).
+void require_shape(const pybind11::array& a, const std::string& name,
+                   const std::vector<pybind11::ssize_t>& shape);
+
+// A C-contiguous array of T with the given shape (-1: any size on that axis),
+// converted from lists and other dtypes.
+template <class T>
+InputArray<T> read_array_of(const pybind11::handle& object, const std::string& name,
+                            const std::vector<pybind11::ssize_t>& shape) {
+  if (object.is_none()) throw std::invalid_argument(name + " must be an array, got None");
+  InputArray<T> a;
+  try {
+    a = InputArray<T>::ensure(object);
+  } catch (const pybind11::error_already_set&) {
+    a = {};
+  }
+  if (!a) throw std::invalid_argument(name + " must be convertible to a numeric array");
+  require_shape(a, name, shape);
+  return a;
+}
+
+// The same for float64, with every value finite.
+InputArray<double> read_array(const pybind11::handle& object, const std::string& name,
+                              const std::vector<pybind11::ssize_t>& shape);
 
 // Throws if any value of the array is NaN or infinite.
 void require_finite(const double* data, size_t count, const std::string& name);

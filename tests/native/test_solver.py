@@ -234,8 +234,8 @@ class BadInput(unittest.TestCase):
         self.assert_error("positions contains a non-finite value at vertex 3", positions=nan)
         self.assert_error("no faces", face_sizes=np.zeros(0, int), face_vertices=np.zeros(0, int),
                           reflectance=np.zeros((0, 3)), emission=np.zeros((0, 3)), two_sided=None)
-        self.assert_error("positions has the wrong shape", positions=a["positions"][:, :2])
-        self.assert_error("reflectance has the wrong shape", reflectance=a["reflectance"][:3])
+        self.assert_error("positions must have shape", positions=a["positions"][:, :2])
+        self.assert_error("reflectance must have shape", reflectance=a["reflectance"][:3])
         self.assert_error("adds up to", face_sizes=a["face_sizes"] + 1)
         self.assert_error("at least 3 vertices", face_sizes=np.array([2, 4, 4, 4, 4, 6]))
         self.assert_error("no emitter", emission=np.zeros_like(a["emission"]))
