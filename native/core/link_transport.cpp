@@ -1,5 +1,6 @@
 #include "core/link_transport.h"
 
+#include <algorithm>
 #include <chrono>
 #include <vector>
 
@@ -24,6 +25,12 @@ bool any_in_front(const dvec3* polygon, int count, const dvec3& point, const dve
     if (glm::dot(normal, polygon[k] - point) > tolerance) return true;
   }
   return false;
+}
+
+double distance_to_segment(const dvec3& p, const dvec3& a, const dvec3& b) {
+  const dvec3 ab = b - a;
+  const double t = std::clamp(glm::dot(p - a, ab) / glm::dot(ab, ab), 0.0, 1.0);
+  return glm::length(p - (a + t * ab));
 }
 
 }  // namespace
@@ -109,21 +116,23 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings) const {
   timings.form_factors += seconds_since(start);
   if (!any) return false;
 
-  // A receiver sample at an emitter vertex (elements meeting at a corner) sees a
-  // value that depends on the direction of approach, and a gradient that grows
-  // without bound as the sample nears the vertex (MATH.md s3): no element size
-  // makes the radiance linear there, so the oracle judges the element by its
-  // other samples. (The sample still gathers: links end on leaves, so its value
-  // is exact for the output.)
+  // A receiver sample touching the emitter's outline (elements meeting at an
+  // edge or a corner) sees the contact itself: at a vertex a value that depends
+  // on the direction of approach and an unbounded gradient (MATH.md s3), on an
+  // edge a slope set by the emitter's width, steep for thin emitters (a table
+  // leg on the floor). No element size makes the radiance linear there, so the
+  // oracle judges the element by its other samples; the sample still gathers.
   start = Clock::now();
   const double contact = 1e-5 * hierarchy.diameter(receiver);
   dvec3 oracle_x[kMaxSamples], oracle_grad[kMaxSamples];
   double oracle_value[kMaxSamples];
   size_t used = 0;
   for (int s = 0; s < ns; ++s) {
-    bool at_vertex = false;
-    for (int k = 0; k < ne; ++k) at_vertex |= glm::length(x[s] - emitter_corners[k]) < contact;
-    if (at_vertex) continue;
+    bool touching = false;
+    for (int k = 0; k < ne; ++k) {
+      touching |= distance_to_segment(x[s], emitter_corners[k], emitter_corners[(k + 1) % ne]) < contact;
+    }
+    if (touching) continue;
     oracle_x[used] = x[s];
     oracle_value[used] = value[s];
     oracle_grad[used] = grad[s];
