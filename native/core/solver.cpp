@@ -89,8 +89,7 @@ class Solver {
   // Links grouped by receiver for the gather, and which links they describe.
   std::vector<std::uint32_t> offset_, order_;
   std::uint64_t links_version_ = 1, grouped_version_ = 0;
-  SolveResult result_;     // the last complete pass
-  bool have_result_ = false;
+  SolveResult result_;  // the last complete pass
   bool budget_hit_ = false;
   int pass_ = 0, passes_ = 1;
   double threshold_ = std::numeric_limits<double>::infinity();
@@ -411,7 +410,6 @@ void Solver::snapshot(double threshold) {
   push_pull_all(hierarchy_, &leaf);
   result_.mesh = make_output_mesh(hierarchy_, leaf);
   stats_.threshold = threshold;
-  have_result_ = true;
 }
 
 SolveResult Solver::run() {
