@@ -76,15 +76,10 @@ bool covered(const Polygon2& region, const std::vector<Polygon2>& triangles, dou
   return false;
 }
 
-// Do the candidates lying in one plane block every segment between the two
-// elements? They must separate the elements (all receiver corners strictly on
-// one side of the plane, all emitter corners on the other), and cover the
-// shaft's cross-section on the plane: the convex hull of the points where the
-// corner-to-corner segments cross it (the hull of the corners meets the plane in
-// exactly that hull).
-bool plane_blocks_shaft(const OccluderScene& scene, const std::vector<std::uint32_t>& group,
-                        const dvec3& normal, double offset, std::span<const dvec3> receiver,
-                        std::span<const dvec3> emitter, double tol) {
+// The plane n.x = offset has the receiver strictly on one side and the emitter
+// strictly on the other.
+bool plane_separates(const dvec3& normal, double offset, std::span<const dvec3> receiver,
+                     std::span<const dvec3> emitter, double tol) {
   double rmin = 1e300, rmax = -1e300, emin = 1e300, emax = -1e300;
   for (const dvec3& p : receiver) {
     const double d = glm::dot(normal, p) - offset;
@@ -94,7 +89,19 @@ bool plane_blocks_shaft(const OccluderScene& scene, const std::vector<std::uint3
     const double d = glm::dot(normal, p) - offset;
     emin = std::min(emin, d), emax = std::max(emax, d);
   }
-  if (!((rmax < -tol && emin > tol) || (rmin > tol && emax < -tol))) return false;
+  return (rmax < -tol && emin > tol) || (rmin > tol && emax < -tol);
+}
+
+// Do the candidates lying in one plane block every segment between the two
+// elements? They must separate the elements (all receiver corners strictly on
+// one side of the plane, all emitter corners on the other), and cover the
+// shaft's cross-section on the plane: the convex hull of the points where the
+// corner-to-corner segments cross it (the hull of the corners meets the plane in
+// exactly that hull).
+bool plane_blocks_shaft(const OccluderScene& scene, const std::vector<std::uint32_t>& group,
+                        const dvec3& normal, double offset, std::span<const dvec3> receiver,
+                        std::span<const dvec3> emitter, double tol) {
+  if (!plane_separates(normal, offset, receiver, emitter, tol)) return false;
   // A frame of the plane.
   const dvec3 helper = std::abs(normal.x) < 0.6 ? dvec3(1, 0, 0) : dvec3(0, 1, 0);
   const dvec3 e1 = glm::normalize(glm::cross(normal, helper));
@@ -161,16 +168,7 @@ ShaftVisibility classify(const OccluderScene& scene, const std::vector<std::uint
     const dvec3 normal = planes[i].normal;
     const double offset = planes[i].offset;
     // The plane must separate the two elements, else nothing in it blocks all.
-    double rmin = 1e300, rmax = -1e300, emin = 1e300, emax = -1e300;
-    for (const dvec3& p : receiver) {
-      const double d = glm::dot(normal, p) - offset;
-      rmin = std::min(rmin, d), rmax = std::max(rmax, d);
-    }
-    for (const dvec3& p : emitter) {
-      const double d = glm::dot(normal, p) - offset;
-      emin = std::min(emin, d), emax = std::max(emax, d);
-    }
-    const bool separates = (rmax < -tol && emin > tol) || (rmin > tol && emax < -tol);
+    const bool separates = plane_separates(normal, offset, receiver, emitter, tol);
     group.clear();
     Aabb box;
     std::size_t j = i;

@@ -30,25 +30,6 @@ Triangle math_occluder() {
   return {{dvec3(0.10, 0.05, 1.00), dvec3(0.45, -0.10, 0.90), dvec3(0.40, 0.20, 1.15)}};
 }
 
-// Segment r -> y blocked by a triangle (Moller-Trumbore, double precision),
-// ignoring hits within a relative 1e-9 of either end.
-bool segment_blocked(const dvec3& r, const dvec3& y, const Triangle& t) {
-  const dvec3 d = y - r;
-  const dvec3 e1 = t.v[1] - t.v[0], e2 = t.v[2] - t.v[0];
-  const dvec3 p = glm::cross(d, e2);
-  const double det = glm::dot(e1, p);
-  if (std::abs(det) < 1e-300) return false;
-  const double inv = 1.0 / det;
-  const dvec3 s = r - t.v[0];
-  const double u = glm::dot(s, p) * inv;
-  if (u < 0.0 || u > 1.0) return false;
-  const dvec3 q = glm::cross(s, e1);
-  const double v = glm::dot(d, q) * inv;
-  if (v < 0.0 || u + v > 1.0) return false;
-  const double h = glm::dot(e2, q) * inv;
-  return h > 1e-9 && h < 1.0 - 1e-9;
-}
-
 struct MonteCarlo {
   double mean = 0.0;
   double standard_error = 0.0;
@@ -89,7 +70,7 @@ MonteCarlo monte_carlo_form_factor(const dvec3& r, const dvec3& n, const Polygon
     if (cr > 0.0 && ce > 0.0) {
       bool blocked = false;
       for (const Triangle& t : occluders)
-        if (segment_blocked(r, y, t)) {
+        if (segment_hits_triangle(r, y, t)) {
           blocked = true;
           break;
         }
