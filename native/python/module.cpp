@@ -14,4 +14,5 @@ PYBIND11_MODULE(_radiosity, m) {
   radiosity::python::bind_kernels(m);
   radiosity::python::bind_visibility(m);
   radiosity::python::bind_solver(m);
+  radiosity::python::bind_image_metric(m);
 }
