@@ -118,17 +118,36 @@ void Solver::track_memory() {
 
 // Evaluates links in parallel, each into its own slot, and keeps the visible
 // ones in their original order: the result does not depend on the thread count.
+// Runs of sibling receivers linked to one emitter (a split receiver's four
+// children, made consecutive by refine) are evaluated together so they share
+// their common corners (CornerMemo); the runs depend only on the link order.
 std::vector<Link> Solver::evaluate_links(std::vector<Link>&& candidates) {
+  std::vector<std::uint32_t> group_start;
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    // Siblings share the normal their corners' values depend on; roots (no
+    // parent) of different faces may share vertices but not normals.
+    const std::int32_t parent = hierarchy_.element(candidates[i].receiver).parent;
+    const bool continues = !group_start.empty() && i - group_start.back() < 4 && parent != kNone &&
+                           candidates[i].emitter == candidates[i - 1].emitter &&
+                           parent == hierarchy_.element(candidates[i - 1].receiver).parent;
+    if (!continues) group_start.push_back(static_cast<std::uint32_t>(i));
+  }
+  group_start.push_back(static_cast<std::uint32_t>(candidates.size()));
+  const size_t groups = group_start.size() - 1;
+
   std::vector<std::uint8_t> visible(candidates.size(), 0);
   tbb::enumerable_thread_specific<LinkTimings> timings;
   // Chunks keep cancellation prompt without a check per link.
-  const size_t chunk = 4096;
-  for (size_t begin = 0; begin < candidates.size() && !cancelled(); begin += chunk) {
-    const size_t end = std::min(candidates.size(), begin + chunk);
+  const size_t chunk = 1024;
+  for (size_t begin = 0; begin < groups && !cancelled(); begin += chunk) {
+    const size_t end = std::min(groups, begin + chunk);
     tbb::parallel_for(tbb::blocked_range<size_t>(begin, end), [&](const auto& range) {
       LinkTimings& local = timings.local();
-      for (size_t i = range.begin(); i != range.end(); ++i) {
-        visible[i] = evaluator_.evaluate(candidates[i], local) ? 1 : 0;
+      for (size_t g = range.begin(); g != range.end(); ++g) {
+        CornerMemo memo;
+        for (size_t i = group_start[g]; i < group_start[g + 1]; ++i) {
+          visible[i] = evaluator_.evaluate(candidates[i], local, &memo) ? 1 : 0;
+        }
       }
     });
   }

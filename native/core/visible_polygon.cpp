@@ -558,7 +558,10 @@ std::span<const ContourVertex> piece_contour(Workspace& w, std::size_t i) {
   return w.contour;
 }
 
-Workspace& thread_workspace() {
+// Not inlined on purpose: inlined, the compiler specialises the helpers for the
+// thread-local object and recomputes its address (__tls_get_addr in a shared
+// module) at every access, about 10 % of a solve.
+[[gnu::noinline]] Workspace& thread_workspace() {
   thread_local Workspace w;
   return w;
 }

@@ -101,6 +101,9 @@ py::dict stats_dict(const SolveStats& s) {
   d["cpu_visibility"] = s.link_cpu.visibility;
   d["cpu_form_factors"] = s.link_cpu.form_factors;
   d["cpu_oracle"] = s.link_cpu.oracle;
+  d["samples_clear"] = s.link_cpu.samples_clear;
+  d["samples_occluded"] = s.link_cpu.samples_occluded;
+  d["samples_shared"] = s.link_cpu.samples_shared;
   d["element_bytes"] = s.element_bytes;
   d["link_bytes"] = s.link_bytes;
   d["peak_bytes"] = s.peak_bytes;
