@@ -7,9 +7,10 @@
    of repetitions, JSON in <build>/bench/<program>.json.
 2. The solver sweep (bench/solver_bench.py): elements, links, time and memory
    per oracle and quality, CSV in <build>/bench/solver.csv.
-
-The speed-accuracy study of issue 7 (renders, error metric, plots, report)
-will be added here.
+3. The speed-accuracy study (bench/study.py, the source's Chapter 7): sweeps,
+   snapshots, error against a refined solution and a Cycles render, Cycles
+   bake comparison; <build>/bench/study.csv, study_*.png and report.md. Quick
+   mode: fewer points, smaller images, fewer samples (a few minutes).
 """
 
 import argparse
@@ -23,7 +24,7 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--build", default="build")
-    parser.add_argument("--blender", default="blender", help="unused until the render study lands")
+    parser.add_argument("--blender", default="blender", help="Blender for the study's renders and bakes")
     parser.add_argument("--quick", action="store_true", help="fewer repetitions and sweep points")
     args = parser.parse_args()
     out = ROOT / args.build / "bench"
@@ -39,6 +40,9 @@ def main():
     command = [sys.executable, str(ROOT / "bench" / "solver_bench.py"), "--build", args.build]
     command += ["--quick", "--repeats", "1"] if args.quick else ["--faces", "1000"]
     subprocess.run(command, check=True)
+    print("== speed-accuracy study", flush=True)
+    subprocess.run([sys.executable, str(ROOT / "bench" / "study.py"), "--build", args.build, "--blender",
+                    args.blender, "--mode", "quick" if args.quick else "full"], check=True)
 
 
 if __name__ == "__main__":

@@ -145,11 +145,12 @@ GrayImage difference_of_gaussians(const GrayImage& image, double sigma_center, d
 
 EdgeFilterSigmas default_edge_sigmas(int width) {
   require_size(width, 1, "default_edge_sigmas");
-  // Centre: 1/320 of the width (2 px at 640), so the filter responds to the
-  // same features at any snapshot size. Surround 1.6 times wider: the ratio at
-  // which a difference of Gaussians approximates the Laplacian of Gaussian
-  // (Marr and Hildreth), i.e. an edge detector with a narrow band.
-  const double center = width / 320.0;
+  // Centre: 1/160 of the width (2 px at 320, 4 px at 640), so the filter
+  // responds to the same features at any snapshot size, and is wide enough to
+  // be sampled well (>= 1 px) down to 160-pixel snapshots. Surround 1.6 times
+  // wider: the ratio at which a difference of Gaussians approximates the
+  // Laplacian of Gaussian (Marr and Hildreth), an edge detector.
+  const double center = width / 160.0;
   return {center, 1.6 * center};
 }
 

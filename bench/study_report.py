@@ -1,0 +1,190 @@
+"""report.md of the study: what was run, the references and their noise, the
+elements and time each oracle needs at equal error (interpolated along its
+curve, curves.py) with perceptual/standard ratios, the least-squares table of
+Section 7.3.4, and the Cycles bake comparison. Numbers only come from the rows
+measured in this run."""
+
+import datetime
+import math
+import os
+import platform
+
+import numpy as np
+
+import curves
+import study_config
+from study_plots import METRICS
+
+
+def fmt(v, digits=3):
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "-"
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    if abs(v) >= 1000:
+        return "%.0f" % v
+    return "%.*g" % (digits, v)
+
+
+def ratio(a, b):
+    return None if a is None or b is None or b == 0 else a / b
+
+
+def oracle_curves(st, metric, cost):
+    out = {}
+    for oracle in study_config.ORACLES:
+        rows = [r for r in st.rows if r["method"] == "radiosity" and r["oracle"] == oracle]
+        out[oracle] = (np.array([r[cost] for r in rows], dtype=float), np.array([r[metric] for r in rows]))
+    return out
+
+
+def equal_error_table(studies, metric):
+    lines = ["| scene | error | std leaves | perc leaves | grad leaves | perc/std leaves | grad/std leaves "
+             "| std s | perc s | grad s | perc/std time | grad/std time |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    summary = {}
+    for st in studies:
+        by_leaves = oracle_curves(st, metric, "leaves")
+        by_time = oracle_curves(st, metric, "seconds")
+        levels = curves.common_levels(list(by_leaves.values()))
+        if not levels:
+            lines.append("| %s | curves do not overlap | | | | | | | | | | |" % st.name)
+            continue
+        for level in levels:
+            n = {o: curves.cost_at_error(*by_leaves[o], level) for o in study_config.ORACLES}
+            t = {o: curves.cost_at_error(*by_time[o], level) for o in study_config.ORACLES}
+            rn, rt = ratio(n["perceptual"], n["standard"]), ratio(t["perceptual"], t["standard"])
+            summary.setdefault(st.name, []).append((rn, rt))
+            lines.append("| %s | %s | %s | %s | %s | **%s** | %s | %s | %s | %s | **%s** | %s |" % (
+                st.name, fmt(level), fmt(n["standard"]), fmt(n["perceptual"]), fmt(n["gradient"]), fmt(rn),
+                fmt(ratio(n["gradient"], n["standard"])), fmt(t["standard"]), fmt(t["perceptual"]),
+                fmt(t["gradient"]), fmt(rt), fmt(ratio(t["gradient"], t["standard"]))))
+    return lines, summary
+
+
+def regression_table(studies):
+    lines = ["| scene | oracle | n | a (s) | b (s per element) | r | time at 5000 leaves (s) |",
+             "|---|---|---|---|---|---|---|"]
+    for st in studies:
+        for oracle in study_config.ORACLES:
+            rows = [r for r in st.rows if r["method"] == "radiosity" and r["oracle"] == oracle]
+            a, b, r, n = curves.least_squares([x["leaves"] for x in rows], [x["seconds"] for x in rows])
+            lines.append("| %s | %s | %d | %s | %s | %s | %s |" % (st.name, oracle, n, fmt(a), fmt(b, 4), fmt(r),
+                                                                fmt(a + 5000 * b)))
+    return lines
+
+
+def bake_tables(studies):
+    lines = ["| scene | vertices | samples | bake s | DoG vs refined | RMS vs refined | DoG vs Cycles | RMS vs Cycles |",
+             "|---|---|---|---|---|---|---|---|"]
+    for st in studies:
+        for b in sorted(st.bake_rows, key=lambda b: (b["vertices"], b["samples"])):
+            lines.append("| %s | %d | %d | %s | %s | %s | %s | %s |" % (
+                st.name, b["vertices"], b["samples"], fmt(b["seconds"]), fmt(b["dog_refined"]),
+                fmt(b["rms_refined"]), fmt(b["dog_cycles"]), fmt(b["rms_cycles"])))
+    # Time to reach the bake's errors with radiosity, against the Cycles reference.
+    lines += ["", "Time each method needs to reach an error against the **Cycles** reference (interpolated "
+              "along each curve; the bake curve runs over all its vertex counts and sample counts; "
+              "'-' = not reached in the measured range):", "",
+              "| scene | metric | error | Cycles bake s | standard s | perceptual s | gradient s |",
+              "|---|---|---|---|---|---|---|"]
+    for st in studies:
+        if not st.bake_rows:
+            continue
+        for metric in ("dog_cycles", "rms_cycles"):
+            bake = (np.array([b["seconds"] for b in st.bake_rows]), np.array([b[metric] for b in st.bake_rows]))
+            rad = oracle_curves(st, metric, "seconds")
+            pooled = [bake] + list(rad.values())
+            lo = min(min(e) for _, e in pooled)
+            hi = max(max(e) for _, e in pooled)
+            for level in np.geomspace(hi, lo, 4)[1:3]:
+                times = [curves.cost_at_error(*bake, level)] + [curves.cost_at_error(*rad[o], level)
+                                                                for o in study_config.ORACLES]
+                lines.append("| %s | %s | %s | %s |" % (st.name, metric.split("_")[0], fmt(level),
+                                                        " | ".join(fmt(t) for t in times)))
+    return lines
+
+
+def write(path, studies, settings, plots, figures, seconds):
+    s = settings
+    sig = None
+    try:
+        import _radiosity
+        sig = _radiosity.edge_filter_sigmas(s["width"])
+    except ImportError:
+        pass
+    out = ["# Speed-accuracy study (source Chapter 7)", "",
+           "Generated by `bench/study.py` (%s mode) on %s, %s, %d CPUs; %s. Total %.0f s, of which solving %.0f s."
+           % (s["mode"], datetime.datetime.now().strftime("%Y-%m-%d %H:%M"), platform.node(), os.cpu_count(),
+              platform.platform(), seconds["total"], seconds["solving"]), "",
+           "## Method", "",
+           "- Each scene is solved outside Blender (the add-on's export of the scene, Lambertian materials) with "
+           "each oracle over a quality range, %d points per oracle placed by bisection on element count (even in "
+           "log leaves; `bench/sweep.py`); converged solves (no fixed bounce count), exact visibility; %s; nothing "
+           "else runs while solving." % (s["points"], "time = median of %d runs for solves under %.0f s, else one run"
+                                         % (s["repeats"], s["repeat_below"]) if s["repeats"] > 1
+                                         else "time of one run"),
+           "- Snapshots: Cycles renders of the baked colours (the add-on's result meshes emitting their radiance) "
+           "from the scene's camera, %d x %d, %d samples of anti-aliasing with a fixed seed, linear EXR, Standard "
+           "view transform." % (s["width"], s["height"], s["render_samples"]),
+           "- Error (Section 6.2.3): brightness = Rec. 709 luminance clipped to [0, 1] and sRGB-encoded (the "
+           "displayed value); **DoG** = eq. 24 on the centre-surround filtered brightness (difference of "
+           "Gaussians, sigma %s px centre and %s px surround, i.e. width/160 and 1.6 times that); **RMS** = eq. "
+           "24 on the unfiltered brightness." % ((fmt(sig[0]), fmt(sig[1])) if sig else ("?", "?")),
+           "- References: (a) a far more refined radiosity solution (standard oracle, as in the source, so any "
+           "bias favours the standard oracle); (b) Cycles path tracing of the original scene with Lambertian "
+           "materials (32 bounces, no clamping), mean of %d seeds of %d samples."
+           % (s["reference_seeds"], s["reference_samples"]),
+           "- Cycles bake: the same arrays uniformly subdivided (`bench/uniform_mesh.py`), Combined pass baked "
+           "to a point float colour attribute, shown through an Emission shader like the radiosity result; "
+           "time = the bake operator.", "",
+           "## Scenes and references", "",
+           "| scene | quality range | refined reference | its leaves | its time (s) | Cycles ref. noise DoG | "
+           "noise RMS | refined vs Cycles DoG | refined vs Cycles RMS |",
+           "|---|---|---|---|---|---|---|---|---|"]
+    for st in studies:
+        ref = next(r for r in st.rows if r["method"] == "refined")
+        out.append("| %s | %s-%s | %s q=%s | %d | %s | %s | %s | %s | %s |" % (
+            st.name, fmt(st.quality_range[0]), fmt(st.quality_range[1]), st.reference[0], fmt(st.reference[1]),
+            ref["leaves"], fmt(ref["seconds"]), fmt(st.noise["dog"]), fmt(st.noise["rms"]),
+            fmt(st.refined_vs_cycles["dog"]), fmt(st.refined_vs_cycles["rms"])))
+    out += ["", "The Cycles reference's noise is the error its own noise alone causes (measured from the "
+            "difference of its seeds); errors against it below that level are not resolved. 'Refined vs Cycles' "
+            "is the floor every radiosity curve meets against the Cycles reference (the solver's remaining bias "
+            "plus that noise).", ""]
+    out += ["## Elements and time at equal error", "",
+            "For each scene, three error levels inside the range all oracles reach; the leaves and seconds each "
+            "oracle needs to get at least that good (lower envelope of its curve, log-log interpolation). "
+            "The source claims perceptual/standard of about 0.5 for both.", ""]
+    summaries = {}
+    for metric, label in METRICS:
+        lines, summary = equal_error_table(studies, metric)
+        summaries[metric] = summary
+        out += ["### %s" % label, ""] + lines + [""]
+    out += ["### Summary: median perceptual/standard ratio over the levels", "",
+            "| scene | " + " | ".join("%s leaves | %s time" % (m.split("_")[0] + " " + m.split("_")[1],
+                                                               m.split("_")[0] + " " + m.split("_")[1])
+                                      for m, _ in METRICS) + " |",
+            "|---|" + "---|---|" * len(METRICS)]
+    for st in studies:
+        cells = []
+        for metric, _ in METRICS:
+            pairs = summaries[metric].get(st.name, [])
+            for k in (0, 1):
+                vals = [p[k] for p in pairs if p[k] is not None]
+                cells.append(fmt(float(np.median(vals))) if vals else "-")
+        out.append("| %s | %s |" % (st.name, " | ".join(cells)))
+    out += ["", "## Time against elements (Section 7.3.4: time = a + b x leaves)", ""] + regression_table(studies)
+    out += ["", "## Equal-size comparison (Sections 7.4-7.5.2)", "",
+            "| scene | oracle | leaves | DoG vs refined | RMS vs refined | DoG vs Cycles | RMS vs Cycles |",
+            "|---|---|---|---|---|---|---|"]
+    for st in studies:
+        for oracle, r in st.comparison.items():
+            out.append("| %s | %s | %d | %s | %s | %s | %s |" % (st.name, oracle, r["leaves"], fmt(r["dog_refined"]),
+                                                                fmt(r["rms_refined"]), fmt(r["dog_cycles"]),
+                                                                fmt(r["rms_cycles"])))
+    out += ["", "## Cycles bake (what a Blender user would do instead)", ""] + bake_tables(studies)
+    out += ["", "## Files", ""] + ["- `%s`" % os.path.basename(str(p)) for p in list(plots) + list(figures)]
+    out += ["- `study.csv`: every solve and bake with its errors; images and solutions under `study/<scene>/`", ""]
+    path.write_text("\n".join(out))
+    return path
