@@ -76,78 +76,60 @@ bool elements_face_each_other(const Hierarchy& h, const Element& receiver, const
          any_in_front(p, np, q[0], h.normal(emitter), tolerance);
 }
 
-bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo) const {
-  const Element& receiver = hierarchy.element(link.receiver);
-  const Element& emitter = hierarchy.element(link.emitter);
-  link.form_factor.fill(0.0f);
-  link.oracle = 0.0f;
-  if (!elements_face_each_other(hierarchy, receiver, emitter)) return false;
+namespace {
 
+// The corners and samples of a link's two elements.
+struct LinkEnds {
   dvec3 receiver_corners[4], emitter_corners[4], x[kMaxSamples];
-  const int nr = hierarchy.corners(receiver, receiver_corners);
-  const int ne = hierarchy.corners(emitter, emitter_corners);
-  const int ns = hierarchy.samples(receiver, x);
-  const std::span<const dvec3> emitter_polygon(emitter_corners, static_cast<size_t>(ne));
-  const dvec3 n = hierarchy.normal(receiver);
+  int nr = 0, ne = 0, ns = 0;
+  dvec3 n{0.0};
+  std::span<const dvec3> receiver_polygon() const { return {receiver_corners, static_cast<size_t>(nr)}; }
+  std::span<const dvec3> emitter_polygon() const { return {emitter_corners, static_cast<size_t>(ne)}; }
+  std::span<const dvec3> samples() const { return {x, static_cast<size_t>(ns)}; }
+};
 
-  auto start = Clock::now();
-  const ShaftCulling culling = cull_shaft(
-      occluders.shafts, std::span<const dvec3>(receiver_corners, static_cast<size_t>(nr)),
-      hierarchy.patch_of(receiver).face, emitter_polygon, hierarchy.patch_of(emitter).face);
-  timings.visibility += seconds_since(start);
-  if (culling.visibility == ShaftVisibility::hidden) return false;
+LinkEnds link_ends(const Hierarchy& h, const Element& receiver, const Element& emitter) {
+  LinkEnds e;
+  e.nr = h.corners(receiver, e.receiver_corners);
+  e.ne = h.corners(emitter, e.emitter_corners);
+  e.ns = h.samples(receiver, e.x);
+  e.n = h.normal(receiver);
+  return e;
+}
 
-  start = Clock::now();
+// Form factor and gradient at each receiver sample.
+struct SampleValues {
+  double value[kMaxSamples] = {};
+  dvec3 grad[kMaxSamples] = {};
+};
+
+std::vector<Triangle>& gather_candidates(const OccluderScene& scene, const ShaftCulling& culling) {
   thread_local std::vector<Triangle> candidates;
   candidates.clear();
-  for (std::uint32_t t : culling.candidates) candidates.push_back(occluders.shafts.triangles[t]);
-  const bool gradient = oracle_needs_gradient(oracle);
-  double value[kMaxSamples];
-  dvec3 grad[kMaxSamples];
+  for (std::uint32_t t : culling.candidates) candidates.push_back(scene.triangles[t]);
+  return candidates;
+}
+
+FormFactorGradient unoccluded(const LinkEvaluator& evaluator, const dvec3& x, const dvec3& n,
+                              std::span<const dvec3> emitter) {
+  return oracle_needs_gradient(evaluator.oracle)
+             ? form_factor_gradient(x, n, emitter)
+             : FormFactorGradient{form_factor(x, n, emitter), dvec3(0.0)};
+}
+
+// Stores the sample form factors and the oracle's geometric criterion; false
+// when no sample sees the emitter.
+bool finish(const LinkEvaluator& evaluator, Link& link, const LinkEnds& ends, const SampleValues& values,
+            LinkTimings& timings) {
+  const Hierarchy& hierarchy = evaluator.hierarchy;
+  const Element& receiver = hierarchy.element(link.receiver);
+  const double* value = values.value;
+  const dvec3* grad = values.grad;
   bool any = false;
-  // A corner is shared with siblings only if it is far from the emitter: close
-  // to it, the sample's millionth offset towards its own element's centre
-  // matters (at a contact, how the light splits between two emitter children
-  // depends on the direction of approach). At a tenth of the receiver's size
-  // away, the offset changes F by about 1e-5 relative.
-  if (memo) memo->use_emitter(link.emitter);
-  const double near = 0.1 * hierarchy.diameter(receiver);
-  for (int s = 0; s < ns; ++s) {
-    const bool corner = s < receiver.corner_count;
-    const std::uint32_t vertex = corner ? receiver.corner[static_cast<size_t>(s)] : 0u;
-    const bool shared = memo && corner && distance_to_polygon(x[s], emitter_polygon) > near;
-    const FormFactorGradient* known = shared ? memo->find(vertex) : nullptr;
-    FormFactorGradient f;
-    if (known) {
-      f = *known;
-      ++timings.samples_shared;
-    } else if (culling.visibility == ShaftVisibility::clear) {
-      ++timings.samples_clear;
-      f = gradient ? form_factor_gradient(x[s], n, emitter_polygon)
-                   : FormFactorGradient{form_factor(x[s], n, emitter_polygon), dvec3(0.0)};
-    } else if (visibility == VisibilityMode::Exact) {
-      ++timings.samples_occluded;
-      f = visible_form_factor_gradient(x[s], n, emitter_polygon, candidates);
-    } else {
-      // Rays per sample vary their seed with the sample, so neighbours do not
-      // share the same stratification pattern.
-      // Few candidates: test them directly in double precision; many: let
-      // Embree traverse the scene (the crossover measured near 35 candidates).
-      ++timings.samples_occluded;
-      const SampledVisibilityOptions options{rays, static_cast<std::uint64_t>(s)};
-      f = candidates.size() > 32 && occluders.rays
-              ? sampled_form_factor_gradient(x[s], n, emitter_polygon, *occluders.rays, options,
-                                             hierarchy.patch_of(receiver).face,
-                                             hierarchy.patch_of(emitter).face)
-              : sampled_form_factor_gradient(x[s], n, emitter_polygon, candidates, options);
-    }
-    if (shared && !known) memo->add(vertex, f);
-    value[s] = std::max(0.0, f.value);
-    grad[s] = f.gradient;
-    link.form_factor[static_cast<size_t>(s)] = static_cast<float>(value[s]);
+  for (int s = 0; s < ends.ns; ++s) {
+    link.form_factor[static_cast<size_t>(s)] = static_cast<float>(std::max(0.0, value[s]));
     any |= value[s] > 0.0;
   }
-  timings.form_factors += seconds_since(start);
   if (!any) return false;
 
   // A receiver sample touching the emitter's outline (elements meeting at an
@@ -156,31 +138,159 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo)
   // edge a slope set by the emitter's width, steep for thin emitters (a table
   // leg on the floor). No element size makes the radiance linear there, so the
   // oracle judges the element by its other samples; the sample still gathers.
-  start = Clock::now();
+  const auto start = Clock::now();
   const double contact = 1e-5 * hierarchy.diameter(receiver);
   dvec3 oracle_x[kMaxSamples], oracle_grad[kMaxSamples];
   double oracle_value[kMaxSamples];
   size_t used = 0;
-  for (int s = 0; s < ns; ++s) {
+  for (int s = 0; s < ends.ns; ++s) {
     bool touching = false;
-    for (int k = 0; k < ne; ++k) {
-      touching |= distance_to_segment(x[s], emitter_corners[k], emitter_corners[(k + 1) % ne]) < contact;
+    for (int k = 0; k < ends.ne; ++k) {
+      touching |= distance_to_segment(ends.x[s], ends.emitter_corners[k],
+                                      ends.emitter_corners[(k + 1) % ends.ne]) < contact;
     }
     if (touching) continue;
-    oracle_x[used] = x[s];
-    oracle_value[used] = value[s];
+    oracle_x[used] = ends.x[s];
+    oracle_value[used] = std::max(0.0, value[s]);
     oracle_grad[used] = grad[s];
     ++used;
   }
   LinkSamples samples{std::span<const dvec3>(oracle_x, used),
                       std::span<const double>(oracle_value, used),
                       std::span<const dvec3>(oracle_grad, used),
-                      n,
+                      ends.n,
                       receiver.area,
                       hierarchy.diameter(receiver)};
-  link.oracle = used >= 2 ? static_cast<float>(oracle_geometry(oracle, samples) / geometric_scale) : 0.0f;
+  link.oracle = used >= 2 ? static_cast<float>(oracle_geometry(evaluator.oracle, samples) / evaluator.geometric_scale) : 0.0f;
   timings.oracle += seconds_since(start);
   return true;
+}
+
+}  // namespace
+
+bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo) const {
+  const Element& receiver = hierarchy.element(link.receiver);
+  const Element& emitter = hierarchy.element(link.emitter);
+  link.form_factor.fill(0.0f);
+  link.oracle = 0.0f;
+  if (!elements_face_each_other(hierarchy, receiver, emitter)) return false;
+  const LinkEnds ends = link_ends(hierarchy, receiver, emitter);
+  const std::span<const dvec3> emitter_polygon = ends.emitter_polygon();
+
+  auto start = Clock::now();
+  const ShaftCulling culling =
+      cull_shaft(occluders.shafts, ends.receiver_polygon(), hierarchy.patch_of(receiver).face,
+                 emitter_polygon, hierarchy.patch_of(emitter).face);
+  timings.visibility += seconds_since(start);
+  if (culling.visibility == ShaftVisibility::hidden) return false;
+
+  start = Clock::now();
+  const std::vector<Triangle>& candidates = gather_candidates(occluders.shafts, culling);
+  SampleValues values;
+  // A corner is shared with siblings only if it is far from the emitter: close
+  // to it, the sample's millionth offset towards its own element's centre
+  // matters (at a contact, how the light splits between two emitter children
+  // depends on the direction of approach). At a tenth of the receiver's size
+  // away, the offset changes F by about 1e-5 relative.
+  if (memo) memo->use_emitter(link.emitter);
+  const double near = 0.1 * hierarchy.diameter(receiver);
+  for (int s = 0; s < ends.ns; ++s) {
+    const dvec3& x = ends.x[s];
+    const bool corner = s < receiver.corner_count;
+    const std::uint32_t vertex = corner ? receiver.corner[static_cast<size_t>(s)] : 0u;
+    const bool shared = memo && corner && distance_to_polygon(x, emitter_polygon) > near;
+    const FormFactorGradient* known = shared ? memo->find(vertex) : nullptr;
+    FormFactorGradient f;
+    if (known) {
+      f = *known;
+      ++timings.samples_shared;
+    } else if (culling.visibility == ShaftVisibility::clear) {
+      ++timings.samples_clear;
+      f = unoccluded(*this, x, ends.n, emitter_polygon);
+    } else if (visibility == VisibilityMode::Exact) {
+      ++timings.samples_occluded;
+      f = visible_form_factor_gradient(x, ends.n, emitter_polygon, candidates);
+    } else {
+      // Rays per sample vary their seed with the sample, so neighbours do not
+      // share the same stratification pattern.
+      // Few candidates: test them directly in double precision; many: let
+      // Embree traverse the scene (the crossover measured near 35 candidates).
+      ++timings.samples_occluded;
+      const SampledVisibilityOptions options{rays, static_cast<std::uint64_t>(s)};
+      f = candidates.size() > 32 && occluders.rays
+              ? sampled_form_factor_gradient(x, ends.n, emitter_polygon, *occluders.rays, options,
+                                             hierarchy.patch_of(receiver).face,
+                                             hierarchy.patch_of(emitter).face)
+              : sampled_form_factor_gradient(x, ends.n, emitter_polygon, candidates, options);
+    }
+    if (shared && !known) memo->add(vertex, f);
+    values.value[s] = f.value;
+    values.grad[s] = f.gradient;
+  }
+  timings.form_factors += seconds_since(start);
+  return finish(*this, link, ends, values, timings);
+}
+
+void LinkEvaluator::evaluate_emitter_siblings(std::span<Link> links, LinkTimings& timings,
+                                              std::span<std::uint8_t> visible) const {
+  const size_t count = links.size();
+  if (visibility != VisibilityMode::Exact || count < 2 || count > 4) {
+    for (size_t i = 0; i < count; ++i) visible[i] = evaluate(links[i], timings) ? 1 : 0;
+    return;
+  }
+  const Element& receiver = hierarchy.element(links[0].receiver);
+  const Element& parent = hierarchy.element(hierarchy.element(links[0].emitter).parent);
+  // The children that face the receiver; their polygons are the parts.
+  std::array<LinkEnds, 4> ends;
+  std::array<std::span<const dvec3>, 4> parts;
+  std::array<size_t, 4> which{};
+  size_t facing = 0;
+  for (size_t i = 0; i < count; ++i) {
+    links[i].form_factor.fill(0.0f);
+    links[i].oracle = 0.0f;
+    visible[i] = 0;
+    const Element& emitter = hierarchy.element(links[i].emitter);
+    if (!elements_face_each_other(hierarchy, receiver, emitter)) continue;
+    ends[facing] = link_ends(hierarchy, receiver, emitter);
+    parts[facing] = ends[facing].emitter_polygon();
+    which[facing++] = i;
+  }
+  if (facing == 0) return;
+
+  dvec3 parent_corners[4];
+  const std::span<const dvec3> parent_polygon(parent_corners,
+                                              static_cast<size_t>(hierarchy.corners(parent, parent_corners)));
+  auto start = Clock::now();
+  const ShaftCulling culling =
+      cull_shaft(occluders.shafts, ends[0].receiver_polygon(), hierarchy.patch_of(receiver).face,
+                 parent_polygon, hierarchy.patch_of(parent).face);
+  timings.visibility += seconds_since(start);
+  if (culling.visibility == ShaftVisibility::hidden) return;
+
+  start = Clock::now();
+  const std::vector<Triangle>& candidates = gather_candidates(occluders.shafts, culling);
+  std::array<SampleValues, 4> values;
+  const LinkEnds& shared = ends[0];  // the receiver's samples are the same for all
+  for (int s = 0; s < shared.ns; ++s) {
+    std::array<FormFactorGradient, 4> f;
+    if (culling.visibility == ShaftVisibility::clear) {
+      timings.samples_clear += facing;
+      for (size_t k = 0; k < facing; ++k) f[k] = unoccluded(*this, shared.x[s], shared.n, parts[k]);
+    } else {
+      ++timings.samples_occluded;
+      timings.samples_shared += facing - 1;
+      visible_form_factor_gradient_parts(shared.x[s], shared.n, parent_polygon,
+                                         std::span<const std::span<const dvec3>>(parts.data(), facing),
+                                         candidates, std::span<FormFactorGradient>(f.data(), facing));
+    }
+    for (size_t k = 0; k < facing; ++k) {
+      values[k].value[s] = f[k].value;
+      values[k].grad[s] = f[k].gradient;
+    }
+  }
+  timings.form_factors += seconds_since(start);
+  for (size_t k = 0; k < facing; ++k)
+    visible[which[k]] = finish(*this, links[which[k]], ends[k], values[k], timings) ? 1 : 0;
 }
 
 }  // namespace radiosity

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 
 #include "core/form_factor.h"
 #include "core/hierarchy.h"
@@ -101,6 +102,13 @@ struct LinkEvaluator {
   // seen from any sample (facing away, coplanar or fully hidden). With a memo,
   // corner values are shared with the siblings evaluated before (same emitter).
   bool evaluate(Link& link, LinkTimings& timings, CornerMemo* memo = nullptr) const;
+
+  // Links from one receiver to two to four children of one emitter element (a
+  // split emitter): the parent's shaft and visible region are computed once per
+  // sample and clipped to each child (exact visibility; sampled visibility
+  // evaluates them one by one). visible[i] is evaluate()'s answer for links[i].
+  void evaluate_emitter_siblings(std::span<Link> links, LinkTimings& timings,
+                                 std::span<std::uint8_t> visible) const;
 };
 
 // Could any part of `emitter` send light to any part of `receiver`? The facing

@@ -118,22 +118,37 @@ void Solver::track_memory() {
 
 // Evaluates links in parallel, each into its own slot, and keeps the visible
 // ones in their original order: the result does not depend on the thread count.
-// Runs of sibling receivers linked to one emitter (a split receiver's four
-// children, made consecutive by refine) are evaluated together so they share
-// their common corners (CornerMemo); the runs depend only on the link order.
+// Runs of up to four links made by one split (refine keeps them consecutive)
+// are evaluated together: sibling receivers linked to one emitter share their
+// common corners (CornerMemo); one receiver linked to sibling emitters shares
+// the parent emitter's shaft and visible region. The runs depend only on the
+// link order.
 std::vector<Link> Solver::evaluate_links(std::vector<Link>&& candidates) {
+  enum class Run : std::uint8_t { Single, SiblingReceivers, SiblingEmitters };
+  const auto parent = [&](std::int32_t e) { return hierarchy_.element(e).parent; };
+  const auto run_of = [&](const Link& a, const Link& b) {
+    // Roots (no parent) of different faces may share vertices but not normals.
+    if (a.emitter == b.emitter && parent(a.receiver) != kNone && parent(a.receiver) == parent(b.receiver))
+      return Run::SiblingReceivers;
+    if (a.receiver == b.receiver && parent(a.emitter) != kNone && parent(a.emitter) == parent(b.emitter))
+      return Run::SiblingEmitters;
+    return Run::Single;
+  };
   std::vector<std::uint32_t> group_start;
+  std::vector<Run> group_kind;
   for (size_t i = 0; i < candidates.size(); ++i) {
-    // Siblings share the normal their corners' values depend on; roots (no
-    // parent) of different faces may share vertices but not normals.
-    const std::int32_t parent = hierarchy_.element(candidates[i].receiver).parent;
-    const bool continues = !group_start.empty() && i - group_start.back() < 4 && parent != kNone &&
-                           candidates[i].emitter == candidates[i - 1].emitter &&
-                           parent == hierarchy_.element(candidates[i - 1].receiver).parent;
-    if (!continues) group_start.push_back(static_cast<std::uint32_t>(i));
+    const Run run = i > 0 ? run_of(candidates[i - 1], candidates[i]) : Run::Single;
+    const bool continues = !group_start.empty() && i - group_start.back() < 4 && run != Run::Single &&
+                           (group_kind.back() == Run::Single || group_kind.back() == run);
+    if (continues) {
+      group_kind.back() = run;
+    } else {
+      group_start.push_back(static_cast<std::uint32_t>(i));
+      group_kind.push_back(Run::Single);
+    }
   }
   group_start.push_back(static_cast<std::uint32_t>(candidates.size()));
-  const size_t groups = group_start.size() - 1;
+  const size_t groups = group_kind.size();
 
   std::vector<std::uint8_t> visible(candidates.size(), 0);
   tbb::enumerable_thread_specific<LinkTimings> timings;
@@ -144,8 +159,14 @@ std::vector<Link> Solver::evaluate_links(std::vector<Link>&& candidates) {
     tbb::parallel_for(tbb::blocked_range<size_t>(begin, end), [&](const auto& range) {
       LinkTimings& local = timings.local();
       for (size_t g = range.begin(); g != range.end(); ++g) {
+        const size_t first = group_start[g], count = group_start[g + 1] - first;
+        if (group_kind[g] == Run::SiblingEmitters) {
+          evaluator_.evaluate_emitter_siblings(std::span<Link>(candidates.data() + first, count), local,
+                                               std::span<std::uint8_t>(visible.data() + first, count));
+          continue;
+        }
         CornerMemo memo;
-        for (size_t i = group_start[g]; i < group_start[g + 1]; ++i) {
+        for (size_t i = first; i < first + count; ++i) {
           visible[i] = evaluator_.evaluate(candidates[i], local, &memo) ? 1 : 0;
         }
       }

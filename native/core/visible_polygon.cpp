@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace radiosity {
 namespace {
@@ -378,9 +379,24 @@ void subtract_occluder(Workspace& w) {
   w.next_pieces.clear();
   w.next_start.assign(1, 0);
   const auto close_piece = [&] { w.next_start.push_back(static_cast<std::uint32_t>(w.next_pieces.size())); };
+  // Bounding boxes first: most pieces lie far from a given occluder, and the
+  // box test is much cheaper than the separating-axis test.
+  dvec2 q_low(std::numeric_limits<double>::infinity()), q_high(-std::numeric_limits<double>::infinity());
+  for (const PlaneVertex& v : q) {
+    q_low = glm::min(q_low, v.p);
+    q_high = glm::max(q_high, v.p);
+  }
+  q_low -= w.tol.plane;
+  q_high += w.tol.plane;
   for (std::size_t piece = 0; piece + 1 < w.start.size(); ++piece) {
     const std::span<const PlaneVertex> p(w.pieces.data() + w.start[piece], w.start[piece + 1] - w.start[piece]);
-    if (disjoint(p, q, w.halves, w.tol)) {
+    dvec2 p_low = p[0].p, p_high = p[0].p;
+    for (const PlaneVertex& v : p) {
+      p_low = glm::min(p_low, v.p);
+      p_high = glm::max(p_high, v.p);
+    }
+    const bool apart = p_high.x <= q_low.x || p_low.x >= q_high.x || p_high.y <= q_low.y || p_low.y >= q_high.y;
+    if (apart || disjoint(p, q, w.halves, w.tol)) {
       w.next_pieces.insert(w.next_pieces.end(), p.begin(), p.end());
       close_piece();
       continue;
@@ -540,22 +556,83 @@ bool compute_visible_pieces(const dvec3& r, const dvec3& n, std::span<const dvec
   return true;
 }
 
-// The contour of piece i, as the kernel wants it, in w.contour. Vertices on the
-// horizon can land a rounding error below it; the kernel would clip them again
-// and make slivers, so they are lifted onto the upper side, within the emitter
-// plane (a shift of about 1e-15 of the scene's size).
-std::span<const ContourVertex> piece_contour(Workspace& w, std::size_t i) {
+// The contour of a visible piece, as the kernel wants it, in w.contour.
+// Vertices on the horizon can land a rounding error below it; the kernel would
+// clip them again and make slivers, so they are lifted onto the upper side,
+// within the emitter plane (a shift of about 1e-15 of the scene's size).
+std::span<const ContourVertex> contour_of(Workspace& w, std::span<const PlaneVertex> piece) {
   const dvec3 n_plane = w.n - glm::dot(w.n, w.frame.normal) * w.frame.normal;
   const double n_plane2 = glm::dot(n_plane, n_plane);
   const double lift = 4e-16 * (glm::length(w.r) + glm::length(w.frame.origin) + w.size);
   w.contour.clear();
-  for (std::uint32_t k = w.start[i]; k < w.start[i + 1]; ++k) {
-    dvec3 pos = w.frame.to_space(w.pieces[k].p);
+  for (const PlaneVertex& v : piece) {
+    dvec3 pos = w.frame.to_space(v.p);
     const double h = glm::dot(w.n, pos - w.r);
     if (h < 0.0 && n_plane2 > 0.0) pos += ((lift - h) / n_plane2) * n_plane;
-    w.contour.push_back(resolve(w.pieces[k].tag, pos, w));
+    w.contour.push_back(resolve(v.tag, pos, w));
   }
   return w.contour;
+}
+
+std::span<const PlaneVertex> piece(const Workspace& w, std::size_t i) {
+  return {w.pieces.data() + w.start[i], w.start[i + 1] - w.start[i]};
+}
+
+// F and gradient of the visible pieces, summed. A non-finite gradient would mean
+// a vertex Jacobian blew up at an exact D1 event (eq. 14 singular); the gradient
+// is undefined there, F is not. Rounding can push the sum a hair outside
+// [0, unoccluded F]; the pieces are a subset of the emitter, so clamp there.
+struct PieceSum {
+  FormFactorGradient sum;
+  void add(const FormFactorGradient& fg) {
+    sum.value += fg.value;
+    sum.gradient += fg.gradient;
+  }
+  FormFactorGradient finish(double unoccluded) const {
+    FormFactorGradient out = sum;
+    if (!std::isfinite(out.gradient.x) || !std::isfinite(out.gradient.y) || !std::isfinite(out.gradient.z))
+      out.gradient = dvec3(0.0);
+    out.value = std::isfinite(out.value) ? std::clamp(out.value, 0.0, unoccluded) : 0.0;
+    return out;
+  }
+};
+
+// The visible pieces clipped to a part of the emitter, F and gradient summed.
+// The part's edges lie on the emitter plane: fixed lines, like its own edges.
+FormFactorGradient part_form_factor_gradient(Workspace& w, std::span<const dvec3> part) {
+  const std::size_t lines = w.lines.size();
+  w.occluder.clear();  // scratch: the part on the emitter plane
+  for (std::size_t i = 0; i < part.size(); ++i) {
+    const dvec3 a = part[i], b = part[(i + 1) % part.size()];
+    const std::int32_t line = w.add_line({Line{a, b - a}, true, false});
+    w.occluder.push_back({w.frame.to_plane(a), Tag{-1, -1, -1, line}});
+  }
+  w.halves.resize(part.size());
+  for (std::size_t i = 0; i < part.size(); ++i) w.halves[i] = edge_half_plane(w.occluder, i);
+  PieceSum total;
+  for (std::size_t i = 0; i + 1 < w.start.size(); ++i) {
+    const std::span<const PlaneVertex> p = piece(w, i);
+    w.rest.assign(p.begin(), p.end());
+    for (const HalfPlane& h : w.halves) {
+      w.dist.resize(w.rest.size());
+      bool any_out = false;
+      for (std::size_t k = 0; k < w.rest.size(); ++k) {
+        w.dist[k] = h.distance(w.rest[k].p);
+        any_out = any_out || w.dist[k] < -w.tol.plane;
+      }
+      if (!any_out) continue;
+      w.inside.clear();
+      clip_tagged<PlaneVertex>(w.rest, w.dist, +1, w.tol.plane, h.line, lerp_plane, w.inside);
+      if (!clean_tail(w.inside, 0, w.tol)) {
+        w.rest.clear();
+        break;
+      }
+      std::swap(w.rest, w.inside);
+    }
+    if (!w.rest.empty()) total.add(form_factor_gradient(w.r, w.n, contour_of(w, w.rest)));
+  }
+  w.lines.resize(lines);
+  return total.finish(form_factor(w.r, w.n, part));
 }
 
 // Not inlined on purpose: inlined, the compiler specialises the helpers for the
@@ -575,7 +652,7 @@ VisiblePolygon visible_polygon(const dvec3& r, const dvec3& n, std::span<const d
   if (!compute_visible_pieces(r, n, emitter, occluders, w, out.occluded)) return out;
   out.pieces.reserve(w.start.size() - 1);
   for (std::size_t i = 0; i + 1 < w.start.size(); ++i) {
-    const std::span<const ContourVertex> c = piece_contour(w, i);
+    const std::span<const ContourVertex> c = contour_of(w, piece(w, i));
     out.pieces.emplace_back(c.begin(), c.end());
   }
   return out;
@@ -589,21 +666,22 @@ FormFactorGradient visible_form_factor_gradient(const dvec3& r, const dvec3& n,
   if (!compute_visible_pieces(r, n, emitter, occluders, w, occluded)) return {};
   const FormFactorGradient unoccluded = form_factor_gradient(r, n, emitter);
   if (!occluded) return unoccluded;
-  FormFactorGradient sum;
-  for (std::size_t i = 0; i + 1 < w.start.size(); ++i) {
-    const FormFactorGradient fg = form_factor_gradient(r, n, piece_contour(w, i));
-    sum.value += fg.value;
-    sum.gradient += fg.gradient;
-  }
-  // A non-finite gradient would mean a vertex Jacobian blew up at an exact D1
-  // event (eq. 14 singular); the gradient is undefined there, F is not. Rounding
-  // can push the sum a hair outside [0, unoccluded F]; the pieces are a subset of
-  // the emitter, so clamp there.
-  if (!std::isfinite(sum.gradient.x) || !std::isfinite(sum.gradient.y) ||
-      !std::isfinite(sum.gradient.z))
-    sum.gradient = dvec3(0.0);
-  sum.value = std::isfinite(sum.value) ? std::clamp(sum.value, 0.0, unoccluded.value) : 0.0;
-  return sum;
+  PieceSum total;
+  for (std::size_t i = 0; i + 1 < w.start.size(); ++i)
+    total.add(form_factor_gradient(r, n, contour_of(w, piece(w, i))));
+  return total.finish(unoccluded.value);
+}
+
+void visible_form_factor_gradient_parts(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter,
+                                        std::span<const std::span<const dvec3>> parts,
+                                        std::span<const Triangle> occluders,
+                                        std::span<FormFactorGradient> out) {
+  std::fill(out.begin(), out.end(), FormFactorGradient{});
+  Workspace& w = thread_workspace();
+  bool occluded = false;
+  if (!compute_visible_pieces(r, n, emitter, occluders, w, occluded)) return;
+  for (std::size_t i = 0; i < parts.size(); ++i)
+    out[i] = occluded ? part_form_factor_gradient(w, parts[i]) : form_factor_gradient(r, n, parts[i]);
 }
 
 }  // namespace radiosity

@@ -329,6 +329,52 @@ TEST(VisiblePolygon, GradientMatchesFiniteDifferencesWithTracesBoxesAndHorizon) 
   EXPECT_LE(skipped, tested / 10);
 }
 
+// The four children of a polygon as the hierarchy makes them: a quad through
+// its edge midpoints and centre, a triangle through its edge midpoints.
+std::vector<Polygon> children_of(const Polygon& p) {
+  const auto mid = [&](size_t i, size_t j) { return 0.5 * (p[i] + p[j]); };
+  if (p.size() == 3) {
+    return {{p[0], mid(0, 1), mid(2, 0)}, {mid(0, 1), p[1], mid(1, 2)}, {mid(2, 0), mid(1, 2), p[2]},
+            {mid(0, 1), mid(1, 2), mid(2, 0)}};
+  }
+  const dvec3 c = 0.25 * (p[0] + p[1] + p[2] + p[3]);
+  return {{p[0], mid(0, 1), c, mid(3, 0)}, {mid(0, 1), p[1], mid(1, 2), c}, {c, mid(1, 2), p[2], mid(2, 3)},
+          {mid(3, 0), c, mid(2, 3), p[3]}};
+}
+
+TEST(VisiblePolygon, PartsOfASplitEmitterMatchOneCallPerPart) {
+  std::mt19937_64 rng(31);
+  int occluded = 0;
+  double worst_value = 0.0, worst_gradient = 0.0;
+  for (int i = 0; i < 300; ++i) {
+    Configuration c = random_configuration(rng, 1 + i % 6, 0.25);
+    // Every third receiver leans over so the horizon cuts the emitter.
+    if (i % 3 == 0) c.n = glm::normalize(dvec3(1.5, 0.3, 1.0));
+    const std::vector<Polygon> children = children_of(c.emitter);
+    std::vector<std::span<const dvec3>> parts(children.begin(), children.end());
+    std::vector<FormFactorGradient> together(children.size());
+    visible_form_factor_gradient_parts(c.r, c.n, c.emitter, parts, c.occluders, together);
+    const FormFactorGradient whole = visible_form_factor_gradient(c.r, c.n, c.emitter, c.occluders);
+    const double scale = std::max(whole.value, 1e-3);
+    double sum = 0.0;
+    for (size_t k = 0; k < children.size(); ++k) {
+      const FormFactorGradient alone = visible_form_factor_gradient(c.r, c.n, children[k], c.occluders);
+      const double gradient_scale = std::max(glm::length(alone.gradient), glm::length(whole.gradient)) + 1e-3;
+      worst_value = std::max(worst_value, std::abs(together[k].value - alone.value) / scale);
+      worst_gradient = std::max(worst_gradient, glm::length(together[k].gradient - alone.gradient) / gradient_scale);
+      EXPECT_NEAR(together[k].value, alone.value, 1e-10 * scale) << "configuration " << i << " part " << k;
+      EXPECT_LT(glm::length(together[k].gradient - alone.gradient), 1e-8 * gradient_scale)
+          << "configuration " << i << " part " << k;
+      sum += together[k].value;
+    }
+    EXPECT_NEAR(sum, whole.value, 1e-10 * scale) << "configuration " << i;
+    occluded += whole.value < form_factor(c.r, c.n, c.emitter) * (1.0 - 1e-9) ? 1 : 0;
+  }
+  std::printf("split emitter: worst value error %.3g, worst gradient error %.3g, %d of 300 occluded\n",
+              worst_value, worst_gradient, occluded);
+  EXPECT_GE(occluded, 150);
+}
+
 TEST(VisiblePolygon, AlignedOccluderHidesExactlyHalf) {
   // Projection of the occluder from the centre covers exactly the right half of the
   // emitter: its edges lie on the emitter's edges (D1 events), and the halves have
