@@ -29,7 +29,6 @@ struct Element {
   std::uint8_t depth = 0;
   std::uint8_t has_links = 0;     // a link ends on this element or an ancestor
   double area = 0.0;
-  std::array<Rgb, kMaxSamples> gathered{};  // sum of F L over this element's own links
   Rgb radiance{0.0};                       // area average, L_e + rho H
 
   int sample_count() const { return corner_count + 1; }
@@ -76,6 +75,11 @@ class Hierarchy {
   // The vertex halfway between two vertices, if some element created it.
   std::int32_t midpoint(std::uint32_t a, std::uint32_t b) const;
 
+  // Releases the unused capacity of the element and vertex arrays.
+  void shrink_to_fit() {
+    elements_.shrink_to_fit();
+    vertices_.shrink_to_fit();
+  }
   std::size_t memory_bytes() const;
 
  private:

@@ -68,8 +68,8 @@ class Solver {
   Split choose_split(const Link& link, double threshold) const;
   bool can_split(std::int32_t e) const { return hierarchy_.element(e).area / 4.0 >= min_area_; }
   bool near_field(const Link& link) const;
-  void gather();
-  double push_pull();
+  void group_links();
+  double gather_push_pull();
   double iterate(double threshold, int max_iterations, double tolerance);
   void snapshot(double threshold);
   void track_memory();
@@ -88,6 +88,7 @@ class Solver {
   std::vector<Link> links_;
   // Links grouped by receiver for the gather, and which links they describe.
   std::vector<std::uint32_t> offset_, order_;
+  std::vector<Rgb> source_;  // radiance per element as the last gather read it
   std::uint64_t links_version_ = 1, grouped_version_ = 0;
   SolveResult result_;  // the last complete pass
   bool budget_hit_ = false;
@@ -110,9 +111,12 @@ void Solver::report(const std::string& phase, double fraction) {
   progress_(p);
 }
 
+// Elements: the hierarchy (elements, vertices, midpoints) and the per-element
+// gather tables; links: the links and their receiver grouping.
 void Solver::track_memory() {
-  stats_.element_bytes = hierarchy_.memory_bytes();
-  stats_.link_bytes = links_.capacity() * sizeof(Link);
+  stats_.element_bytes = hierarchy_.memory_bytes() + offset_.capacity() * sizeof(std::uint32_t) +
+                         source_.capacity() * sizeof(Rgb);
+  stats_.link_bytes = links_.capacity() * sizeof(Link) + order_.capacity() * sizeof(std::uint32_t);
   stats_.peak_bytes = std::max(stats_.peak_bytes, stats_.element_bytes + stats_.link_bytes);
 }
 
@@ -331,38 +335,51 @@ bool Solver::refine(double threshold) {
     track_memory();
     report("refining", (pass_ + 0.5) / (passes_ + 1.0));
   }
+  if (changed) {
+    // Growth by doubling leaves up to half of each array unused until the next
+    // refinement: give it back.
+    links_.shrink_to_fit();
+    hierarchy_.shrink_to_fit();
+    track_memory();
+  }
   return changed;
 }
 
-// H_p[s] = sum over p's links of F_s L_q, per receiver in link order.
-void Solver::gather() {
-  auto& elements = hierarchy_.elements();
-  for (Element& e : elements) e.gathered.fill(Rgb(0.0));
-  // Group links by receiver (counting sort keeps link order within a
-  // receiver); rebuilt only when refinement changed the links.
-  if (links_version_ != grouped_version_) {
-    offset_.assign(elements.size() + 1, 0);
-    for (const Link& l : links_) ++offset_[static_cast<size_t>(l.receiver) + 1];
-    for (size_t i = 1; i < offset_.size(); ++i) offset_[i] += offset_[i - 1];
-    order_.resize(links_.size());
-    std::vector<std::uint32_t> next(offset_.begin(), offset_.end() - 1);
-    for (std::uint32_t i = 0; i < links_.size(); ++i) order_[next[static_cast<size_t>(links_[i].receiver)]++] = i;
-    grouped_version_ = links_version_;
-  }
-  const auto& offset = offset_;
-  const auto& order = order_;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, elements.size()), [&](const auto& range) {
-    for (size_t e = range.begin(); e != range.end(); ++e) {
-      std::array<glm::dvec3, kMaxSamples> h{};
-      for (std::uint32_t k = offset[e]; k < offset[e + 1]; ++k) {
-        const Link& l = links_[order[k]];
-        const glm::dvec3 radiance(hierarchy_.element(l.emitter).radiance);
-        for (int s = 0; s < kMaxSamples; ++s) h[static_cast<size_t>(s)] += static_cast<double>(l.form_factor[static_cast<size_t>(s)]) * radiance;
-      }
-      for (int s = 0; s < kMaxSamples; ++s) elements[e].gathered[static_cast<size_t>(s)] = Rgb(h[static_cast<size_t>(s)]);
-    }
-  });
+// Groups the links by receiver (counting sort keeps link order within a
+// receiver); rebuilt only when refinement changed the links.
+void Solver::group_links() {
+  const size_t elements = hierarchy_.elements().size();
+  if (links_version_ == grouped_version_ && offset_.size() == elements + 1) return;
+  offset_.assign(elements + 1, 0);
+  for (const Link& l : links_) ++offset_[static_cast<size_t>(l.receiver) + 1];
+  for (size_t i = 1; i < offset_.size(); ++i) offset_[i] += offset_[i - 1];
+  order_.resize(links_.size());
+  order_.shrink_to_fit();
+  std::vector<std::uint32_t> next(offset_.begin(), offset_.end() - 1);
+  for (std::uint32_t i = 0; i < links_.size(); ++i) order_[next[static_cast<size_t>(links_[i].receiver)]++] = i;
+  grouped_version_ = links_version_;
 }
+
+// What an element gathers through its own links, per sample: H[s] = sum of
+// F_s L_q, with the emitters' radiances of the previous iteration (Jacobi), so
+// the result does not depend on the order elements are visited in. Computed
+// where push/pull needs it instead of stored per element.
+struct LinkGather {
+  const std::vector<Link>& links;
+  const std::vector<std::uint32_t>& offset;
+  const std::vector<std::uint32_t>& order;
+  const std::vector<Rgb>& source;
+
+  std::array<Rgb, kMaxSamples> operator()(std::int32_t e) const {
+    std::array<Rgb, kMaxSamples> h{};
+    for (std::uint32_t k = offset[static_cast<size_t>(e)]; k < offset[static_cast<size_t>(e) + 1]; ++k) {
+      const Link& l = links[order[k]];
+      const Rgb& radiance = source[static_cast<size_t>(l.emitter)];
+      for (size_t s = 0; s < kMaxSamples; ++s) h[s] += static_cast<double>(l.form_factor[s]) * radiance;
+    }
+    return h;
+  }
+};
 
 // Push H down with each element's interpolant, pull L up as area averages.
 // Returns the relative change of radiance, area-weighted over leaves.
@@ -371,10 +388,11 @@ struct Change {
 };
 
 Rgb push_pull_element(Hierarchy& h, std::int32_t index, const std::array<Rgb, kMaxSamples>& down,
-                      Change& change, std::vector<std::array<Rgb, kMaxSamples>>* leaf_out) {
+                      const LinkGather& gather, Change& change,
+                      std::vector<std::array<Rgb, kMaxSamples>>* leaf_out) {
   Element& e = h.element(index);
-  std::array<Rgb, kMaxSamples> total;
-  for (int s = 0; s < kMaxSamples; ++s) total[static_cast<size_t>(s)] = down[static_cast<size_t>(s)] + e.gathered[static_cast<size_t>(s)];
+  std::array<Rgb, kMaxSamples> total = gather(index);
+  for (size_t s = 0; s < kMaxSamples; ++s) total[s] += down[s];
   Rgb radiance;
   if (e.is_leaf()) {
     radiance = h.emission(e) + h.reflectance(e) * Interpolant::average(e.corner_count, total);
@@ -389,7 +407,7 @@ Rgb push_pull_element(Hierarchy& h, std::int32_t index, const std::array<Rgb, kM
     for (int c = 0; c < 4; ++c) {
       std::array<Rgb, kMaxSamples> child_down{};
       for (int s = 0; s <= corners; ++s) child_down[static_cast<size_t>(s)] = Interpolant::at_child_sample(corners, total, c, s);
-      const Rgb child = push_pull_element(h, first + c, child_down, change, leaf_out);
+      const Rgb child = push_pull_element(h, first + c, child_down, gather, change, leaf_out);
       const double child_area = h.element(first + c).area;
       sum += child_area * glm::dvec3(child);
       area += child_area;
@@ -400,13 +418,14 @@ Rgb push_pull_element(Hierarchy& h, std::int32_t index, const std::array<Rgb, kM
   return radiance;
 }
 
-double push_pull_all(Hierarchy& h, std::vector<std::array<Rgb, kMaxSamples>>* leaf_out) {
+double push_pull_all(Hierarchy& h, const LinkGather& gather,
+                     std::vector<std::array<Rgb, kMaxSamples>>* leaf_out) {
   const size_t roots = h.root_count();
   std::vector<Change> changes(roots);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, roots), [&](const auto& range) {
     for (size_t r = range.begin(); r != range.end(); ++r) {
       const std::int32_t root = h.root(static_cast<std::uint32_t>(r / 2), static_cast<int>(r % 2));
-      if (root != kNone) push_pull_element(h, root, {}, changes[r], leaf_out);
+      if (root != kNone) push_pull_element(h, root, {}, gather, changes[r], leaf_out);
     }
   });
   Change sum;
@@ -414,7 +433,17 @@ double push_pull_all(Hierarchy& h, std::vector<std::array<Rgb, kMaxSamples>>* le
   return sum.total > 0.0 ? sum.delta / sum.total : 0.0;
 }
 
-double Solver::push_pull() { return push_pull_all(hierarchy_, nullptr); }
+// One Jacobi iteration: the links read the radiances as they are now.
+double Solver::gather_push_pull() {
+  group_links();
+  const auto& elements = hierarchy_.elements();
+  source_.resize(elements.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, elements.size()), [&](const auto& range) {
+    for (size_t e = range.begin(); e != range.end(); ++e) source_[e] = elements[e].radiance;
+  });
+  return push_pull_all(hierarchy_, LinkGather{links_, offset_, order_, source_}, nullptr);
+}
+
 
 // Refine, gather, push/pull until converged (or `max_iterations`). Returns the
 // last residual.
@@ -432,8 +461,7 @@ double Solver::iterate(double threshold, int max_iterations, double tolerance) {
     }
     if (cancelled()) break;
     const auto start = Clock::now();
-    gather();
-    residual = push_pull();
+    residual = gather_push_pull();
     stats_.seconds_gather += std::chrono::duration<double>(Clock::now() - start).count();
     ++stats_.iterations;
     stats_.residual = residual;
@@ -446,8 +474,13 @@ double Solver::iterate(double threshold, int max_iterations, double tolerance) {
 }
 
 void Solver::snapshot(double threshold) {
+  // The same radiances as the last iteration read: this push/pull repeats it,
+  // keeping what each leaf sample gathered. Before the first iteration nothing
+  // has been gathered yet (emitters only): the links read zero.
   std::vector<std::array<Rgb, kMaxSamples>> leaf(hierarchy_.elements().size());
-  push_pull_all(hierarchy_, &leaf);
+  source_.resize(hierarchy_.elements().size(), Rgb(0.0));
+  group_links();
+  push_pull_all(hierarchy_, LinkGather{links_, offset_, order_, source_}, &leaf);
   result_.mesh = make_output_mesh(hierarchy_, leaf);
   stats_.threshold = threshold;
 }
