@@ -50,6 +50,18 @@ def cost_at_error(cost, error, level):
     return None
 
 
+def cost_to_reach(cost, error, level):
+    """(bound, value): ("=", interpolated cost), ("<=", cheapest cost) when even the
+    cheapest point is at least as good, or (">", dearest cost) when never reached."""
+    env = envelope(np.asarray(cost, dtype=float), np.asarray(error, dtype=float))
+    if not env:
+        return None, None
+    if env[0][1] <= level:
+        return "<=", env[0][0]
+    value = cost_at_error(cost, error, level)
+    return ("=", value) if value is not None else (">", env[-1][0])
+
+
 def common_levels(curves, count=3):
     """`count` error levels, geometrically spaced, that every curve (list of
     (cost, error) arrays) passes through: between the largest of the curves'

@@ -106,17 +106,19 @@ def solve_all(rad, study, settings):
 def match_sizes(rad, scene, study, known):
     """Solutions of every oracle with (about) the same number of leaves, for the
     figures of Sections 7.4-7.5.2: a size inside every oracle's range if there
-    is one, low enough that the coarse mesh still shows (the geometric middle of
-    the overlap's lower half), else the standard oracle's middle."""
+    is one, low enough that the coarse mesh still shows (a quarter of the way up
+    the overlap, in log), else the largest of the oracles' coarsest sizes."""
     ranges = {o: (min(n for _, n in k), max(n for _, n in k)) for o, k in known.items()}
     lo = max(r[0] for r in ranges.values())
     hi = min(r[1] for r in ranges.values())
-    target = (lo ** 0.75 * hi ** 0.25) if lo < hi else math.sqrt(ranges["standard"][0] * ranges["standard"][1])
+    # No common range (an oracle's coarsest solve is finer than another's finest):
+    # the size of the coarsest solve that every oracle can match by refining further.
+    target = (lo ** 0.75 * hi ** 0.25) if lo < hi else lo
     for oracle in study_config.ORACLES:
         rows = [r for r in study.rows if r["oracle"] == oracle and r["method"] == "radiosity"]
         nearest = min(rows, key=lambda r: abs(math.log(max(1, r["leaves"]) / target)))
         if abs(math.log(max(1, nearest["leaves"]) / target)) > 0.08:
-            found = sweep.match_leaves(rad, scene, oracle, target, known[oracle])
+            found = sweep.match_leaves(rad, scene, oracle, target, known[oracle], study.reference[1] - 0.01)
             if found is not None and (abs(math.log(found[1]["leaves"] / target))
                                       < abs(math.log(max(1, nearest["leaves"]) / target))):
                 result, row = found

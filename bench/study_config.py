@@ -32,8 +32,8 @@ MODES = {
         render_samples=16,            # anti-aliasing of the baked-colour snapshots
         points=8,                     # solves per oracle and scene
         repeats=3, repeat_below=5.0,  # median of 3 for solves under 5 s, else one run
-        reference_samples=512, reference_seeds=2,
-        bake=((1000, 16), (1000, 64), (4000, 16), (4000, 64), (16000, 16), (16000, 64)),
+        reference_samples=384, reference_seeds=2,
+        bake=tuple((v, s) for v in (1000, 4000, 16000) for s in (16, 64, 256)),
         reference_quality_scale=1.0,
     ),
     "quick": dict(

@@ -92,24 +92,29 @@ def sweep(rad, scene, oracle, quality_range, points, on_solve, repeats=1, repeat
         done.append((q, max(1, row["leaves"])))
 
 
-def match_leaves(rad, scene, oracle, target, known, tries=4, tolerance=0.08):
+def match_leaves(rad, scene, oracle, target, known, q_max, tries=4, tolerance=0.08):
     """A solve of `oracle` with about `target` leaves (the equal-size comparison of
-    Section 7.5.2), by secant steps in (quality, log leaves) between the sweep's
-    points `known` [(quality, leaves)]. Returns (result, row), the closest found,
-    or None if the target is outside the known counts (the caller then takes the
-    nearest sweep point)."""
+    Section 7.5.2), by secant steps in (quality, log leaves) from the sweep's
+    points `known` [(quality, leaves)], beyond the sweep's top if needed (up to
+    q_max). Returns (result, row), the closest found, or None if the target lies
+    below the oracle's coarsest solve (the caller then takes that solve)."""
     known = sorted(known)
     best = None
     for _ in range(tries):
         below = [p for p in known if p[1] <= target]
         above = [p for p in known if p[1] > target]
-        if not below or not above:
+        if not below:
             break
-        (q0, n0), (q1, n1) = below[-1], above[0]
-        if q1 - q0 < MIN_QUALITY_STEP:
+        if above:
+            (q0, n0), (q1, n1) = below[-1], above[0]
+            lo, hi = q0, q1
+        else:   # extrapolate from the two finest solves
+            (q0, n0), (q1, n1) = known[-2], known[-1]
+            lo, hi = q1, q_max
+        if hi - lo < MIN_QUALITY_STEP:
             break
-        t = (math.log(target) - math.log(n0)) / (math.log(n1) - math.log(n0)) if n1 != n0 else 0.5
-        q = q0 + min(max(t, 0.05), 0.95) * (q1 - q0)
+        t = (math.log(target) - math.log(n0)) / (math.log(n1) - math.log(n0)) if n1 != n0 else 1.5
+        q = min(max(q0 + t * (q1 - q0), lo + 0.05 * (hi - lo)), hi - 0.05 * (hi - lo))
         result, row = solve_point(rad, scene, oracle, q)
         known = sorted(known + [(q, max(1, row["leaves"]))])
         error = abs(math.log(row["leaves"] / target))
