@@ -33,6 +33,17 @@ def bounded(pair):
     return fmt(value) if bound == "=" else "%s %s" % (bound, fmt(value))
 
 
+def exposure_ratio(st):
+    """Mean linear luminance (clipped at 1) of the refined snapshot over the Cycles one's."""
+    try:
+        import _radiosity as rad
+    except ImportError:
+        return None
+    lum = [np.clip(rad.brightness(rad.read_image(str(st.image_path(tag))), "linear"), 0, 1).mean()
+           for tag in ("refined", "cycles")]
+    return float(lum[0] / lum[1])
+
+
 def ratio(a, b):
     return None if a is None or b is None or b == 0 else a / b
 
@@ -146,18 +157,20 @@ def write(path, studies, settings, plots, figures, seconds):
            "time = the bake operator.", "",
            "## Scenes and references", "",
            "| scene | quality range | refined reference | its leaves | its time (s) | Cycles ref. noise DoG | "
-           "noise RMS | refined vs Cycles DoG | refined vs Cycles RMS |",
-           "|---|---|---|---|---|---|---|---|---|"]
+           "noise RMS | refined vs Cycles DoG | refined vs Cycles RMS | exposure refined / Cycles |",
+           "|---|---|---|---|---|---|---|---|---|---|"]
     for st in studies:
         ref = next(r for r in st.rows if r["method"] == "refined")
-        out.append("| %s | %s-%s | %s q=%s | %d | %s | %s | %s | %s | %s |" % (
+        out.append("| %s | %s-%s | %s q=%s | %d | %s | %s | %s | %s | %s | %s |" % (
             st.name, fmt(st.quality_range[0]), fmt(st.quality_range[1]), st.reference[0], fmt(st.reference[1]),
             ref["leaves"], fmt(ref["seconds"]), fmt(st.noise["dog"]), fmt(st.noise["rms"]),
-            fmt(st.refined_vs_cycles["dog"]), fmt(st.refined_vs_cycles["rms"])))
+            fmt(st.refined_vs_cycles["dog"]), fmt(st.refined_vs_cycles["rms"]), fmt(exposure_ratio(st), 4)))
     out += ["", "The Cycles reference's noise is the error its own noise alone causes (measured from the "
             "difference of its seeds); errors against it below that level are not resolved. 'Refined vs Cycles' "
             "is the floor every radiosity curve meets against the Cycles reference (the solver's remaining bias "
-            "plus that noise).", ""]
+            "plus that noise). Exposure: mean linear luminance (clipped at 1) of the refined solution's snapshot "
+            "over the path-traced one's; 1 means the two renders agree in brightness (the solver is known to "
+            "come out a few per cent dark in closed rooms, tests/blender/test_cycles.py).", ""]
     out += ["## Elements and time at equal error", "",
             "For each scene, three error levels inside the range all oracles reach; the leaves and seconds each "
             "oracle needs to get at least that good (lower envelope of its curve, log-log interpolation). "
