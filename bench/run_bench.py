@@ -37,8 +37,9 @@ def main():
                         f"--benchmark_out={out / (program + '.json')}", "--benchmark_out_format=json"]
                        + (["--benchmark_min_time=0.05"] if args.quick else []), check=True)
     print("== solver", flush=True)
-    command = [sys.executable, str(ROOT / "bench" / "solver_bench.py"), "--build", args.build]
-    command += ["--quick", "--repeats", "1"] if args.quick else ["--faces", "1000"]
+    command = [sys.executable, str(ROOT / "bench" / "solver_bench.py"), "--build", args.build,
+               "--blender", args.blender]
+    command += ["--quick", "--repeats", "1"] if args.quick else []
     subprocess.run(command, check=True)
     print("== speed-accuracy study", flush=True)
     subprocess.run([sys.executable, str(ROOT / "bench" / "study.py"), "--build", args.build, "--blender",

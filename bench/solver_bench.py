@@ -1,11 +1,14 @@
 #!/usr/bin/env python3
-"""Solver benchmark: elements, links, time and memory per oracle and quality on
-array-built scenes, and initial linking on a generated many-face scene.
+"""Solver benchmark: elements, links, time and memory per oracle at two quality
+levels on the bundled scenes (exported from Blender as the add-on does) and on
+array-built scenes, and initial linking on generated many-face scenes.
 
-    /usr/bin/python3 bench/solver_bench.py [--build build] [--faces 10000] [--quick]
+    /usr/bin/python3 bench/solver_bench.py [--build build] [--blender blender]
+                                           [--faces 250 500 1000] [--quick]
 
-Writes a table to stdout and CSV to <build>/bench/solver.csv. Times are the
-median of --repeats runs (the machine is shared and noisy).
+Writes CSV to <build>/bench/solver.csv and a Markdown table to
+<build>/bench/solver.md. Times are the median of --repeats runs (the machine is
+shared and noisy); CPU seconds of the process are reported beside them.
 """
 
 import argparse
@@ -19,7 +22,41 @@ import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests" / "native"))
+sys.path.insert(0, str(ROOT / "scenes"))
+sys.path.insert(0, str(ROOT / "bench"))
 from synthetic_scenes import SceneBuilder, room_with_blocker  # noqa: E402
+
+BUNDLED = ("cube", "office", "full_office", "dining_room")
+ORACLES = ("standard", "perceptual", "gradient")
+
+
+class ArrayScene:
+    """A scene exported from Blender (bench/blender_export.py), solvable like a SceneBuilder."""
+
+    def __init__(self, path):
+        self.arrays = np.load(path)
+        self.faces = self.arrays["face_sizes"]
+
+    def scene(self, rad):
+        a = self.arrays
+        return rad.Scene(a["positions"], a["face_vertices"], a["face_sizes"], a["reflectance"], a["emission"],
+                         a["two_sided"])
+
+
+def export_bundled(name, build, blender):
+    """Build the bundled scene's .blend and export its arrays (cached in <build>/bench/scenes)."""
+    from build_all import build_scene
+    import blender_jobs
+    out = ROOT / build / "bench" / "scenes"
+    out.mkdir(parents=True, exist_ok=True)
+    arrays = out / (name + ".npz")
+    if not arrays.exists():
+        blend = out / (name + ".blend")
+        ok, text = build_scene(blender, name, blend)
+        if not ok:
+            raise RuntimeError("building %s failed:\n%s" % (name, text[-3000:]))
+        blender_jobs.export(blender, blend, str(ROOT / build / "addon"), arrays)
+    return ArrayScene(arrays)
 
 
 def office(b=None):
@@ -56,25 +93,37 @@ def box_field(faces):
 
 
 def measure(rad, builder, oracle, quality, repeats, **options):
-    times, result = [], None
+    times, cpu, result = [], [], None
     for _ in range(repeats):
-        start = time.perf_counter()
+        start, start_cpu = time.perf_counter(), time.process_time()
         result = rad.solve(builder.scene(rad), oracle=oracle, quality=quality, **options)
         times.append(time.perf_counter() - start)
+        cpu.append(time.process_time() - start_cpu)
     s = result.stats
-    return dict(oracle=oracle, quality=quality, seconds=statistics.median(times), elements=s["elements"],
+    return dict(oracle=oracle, quality=quality, seconds=round(statistics.median(times), 3),
+                cpu_seconds=round(statistics.median(cpu), 3), leaves=s["leaves"], elements=s["elements"],
                 links=s["links"], iterations=s["iterations"], passes=s["passes"],
                 bytes_per_element=round(s["bytes_per_element"], 1), bytes_per_link=round(s["bytes_per_link"], 1),
                 peak_mb=round(s["peak_bytes"] / 2**20, 1), rss_mb=round(s["peak_rss_bytes"] / 2**20, 1),
                 linking_s=round(s["seconds_linking"], 3), cpu_visibility=round(s["cpu_visibility"], 2),
-                cpu_form_factors=round(s["cpu_form_factors"], 2), gather_s=round(s["seconds_gather"], 2))
+                cpu_form_factors=round(s["cpu_form_factors"], 2), gather_s=round(s["seconds_gather"], 2),
+                samples_occluded=s["samples_occluded"], samples_shared=s["samples_shared"])
+
+
+def markdown(rows):
+    keys = ("scene", "faces", "oracle", "quality", "seconds", "cpu_seconds", "leaves", "elements", "links",
+            "bytes_per_element", "bytes_per_link", "peak_mb", "linking_s")
+    lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
+    lines += ["| " + " | ".join(str(r[k]) for k in keys) + " |" for r in rows]
+    return "\n".join(lines) + "\n"
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--build", default="build")
-    parser.add_argument("--faces", type=int, default=1000,
-                        help="faces of the generated scene (initial linking grows as faces^2.2)")
+    parser.add_argument("--blender", default="blender")
+    parser.add_argument("--faces", type=int, nargs="+", default=[250, 500, 1000],
+                        help="faces of the generated scenes (initial linking grows about as faces^2.7)")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--quick", action="store_true", help="fewer points, smaller generated scene")
     args = parser.parse_args()
@@ -82,20 +131,23 @@ def main():
     import _radiosity as rad
 
     rows = []
-    scenes = {"room": room_with_blocker()[0], "office": office()}
+
+    def run(name, builder, oracle, quality, repeats):
+        row = dict(scene=name, faces=len(builder.faces), **measure(rad, builder, oracle, quality, repeats))
+        rows.append(row)
+        print(row, flush=True)
+
+    scenes = {name: export_bundled(name, args.build, args.blender)
+              for name in (("cube", "office") if args.quick else BUNDLED)}
+    scenes.update({"room": room_with_blocker()[0], "office_synthetic": office()})
     qualities = (0.3,) if args.quick else (0.3, 0.5)
     for name, builder in scenes.items():
-        for oracle in ("standard", "perceptual", "gradient"):
+        for oracle in ORACLES:
             for quality in qualities:
-                row = dict(scene=name, faces=len(builder.faces), **measure(rad, builder, oracle, quality, args.repeats))
-                rows.append(row)
-                print(row, flush=True)
-    faces = 1000 if args.quick else args.faces
-    field = box_field(faces)
-    row = dict(scene=f"box_field_{len(field.faces)}", faces=len(field.faces),
-               **measure(rad, field, "standard", 0.0, 1))
-    rows.append(row)
-    print(row, flush=True)
+                run(name, builder, oracle, quality, args.repeats)
+    for faces in ([250] if args.quick else args.faces):
+        field = box_field(faces)
+        run("box_field_%d" % len(field.faces), field, "standard", 0.0, 1)
 
     out = ROOT / args.build / "bench"
     out.mkdir(parents=True, exist_ok=True)
@@ -103,7 +155,8 @@ def main():
         writer = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
         writer.writeheader()
         writer.writerows(rows)
-    print(f"wrote {out / 'solver.csv'}")
+    (out / "solver.md").write_text(markdown(rows))
+    print(f"wrote {out / 'solver.csv'} and {out / 'solver.md'}")
 
 
 if __name__ == "__main__":
