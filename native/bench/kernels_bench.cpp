@@ -1,5 +1,6 @@
 // Cost of one form-factor evaluation, alone and with its gradient, for a quad
-// and for a 12-vertex visible polygon (mixed intrinsic and apparent vertices).
+// and for a 12-vertex visible polygon (mixed intrinsic and apparent vertices);
+// and of one patch-to-patch form factor, near (shared edge) and far.
 // Run: build/bench/kernels_bench --benchmark_repetitions=9 --benchmark_report_aggregates_only
 #include <benchmark/benchmark.h>
 
@@ -8,6 +9,7 @@
 #include <vector>
 
 #include "core/form_factor.h"
+#include "core/patch_form_factor.h"
 
 namespace radiosity {
 namespace {
@@ -102,6 +104,23 @@ void BM_FormFactorGradientVisible12(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_FormFactorGradientVisible12);
+
+// Patch-to-patch F: a floor and a wall sharing an edge (contour form with
+// contact singularities), and two facing squares 10 sizes apart (point-kernel
+// quadrature).
+void BM_PatchFormFactorNear(benchmark::State& state) {
+  const std::vector<dvec3> floor = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  const std::vector<dvec3> wall = {{0, 0, 0}, {0, 1, 0}, {0, 1, 0.7}, {0, 0, 0.7}};
+  for (auto _ : state) benchmark::DoNotOptimize(patch_form_factor(floor, wall));
+}
+BENCHMARK(BM_PatchFormFactorNear);
+
+void BM_PatchFormFactorFar(benchmark::State& state) {
+  const std::vector<dvec3> floor = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  const std::vector<dvec3> ceiling = {{0.3, 0, 10}, {0.3, 1, 10}, {1.3, 1, 10}, {1.3, 0, 10}};
+  for (auto _ : state) benchmark::DoNotOptimize(patch_form_factor(floor, ceiling));
+}
+BENCHMARK(BM_PatchFormFactorFar);
 
 }  // namespace
 }  // namespace radiosity
