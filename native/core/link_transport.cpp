@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/form_factor.h"
+#include "core/patch_form_factor.h"
 #include "core/sampled_visibility.h"
 #include "core/visible_polygon.h"
 
@@ -117,19 +118,42 @@ FormFactorGradient unoccluded(const LinkEvaluator& evaluator, const dvec3& x, co
              : FormFactorGradient{form_factor(x, n, emitter), dvec3(0.0)};
 }
 
+// The five samples integrate F over the receiver only approximately, badly
+// near an emitter (F grows quickly towards it): a link would move more or less
+// light than the two patches exchange (10 to 25 % at coarse levels, so energy
+// was not conserved). The exact patch form factor F_pq fixes the samples'
+// average (the interpolant's, which is what the receiver absorbs). The fix is
+// additive, delta = F_pq - average: at a sample that sees all of a closed scene
+// through links of one level, the form factors still sum to one (the deltas of
+// those links sum to zero), so the furnace stays exact. It is scaled by each
+// sample's visible fraction, so hidden samples stay dark. A sample can end a
+// little below zero where F falls steeply; the gather's sum is what matters and
+// the output clamps at zero.
+void conserve_energy(const Element& receiver, const LinkEnds& ends, bool unoccluded, SampleValues& values) {
+  std::array<Rgb, kMaxSamples> open{};
+  double visible[kMaxSamples] = {};
+  for (int s = 0; s < ends.ns; ++s) {
+    const double f = unoccluded ? values.value[s] : form_factor(ends.x[s], ends.n, ends.emitter_polygon());
+    open[static_cast<size_t>(s)] = Rgb(f);
+    visible[s] = f > 0.0 ? std::clamp(values.value[s] / f, 0.0, 1.0) : 0.0;
+  }
+  const double average = Interpolant::average(receiver.corner_count, open).x;
+  // 1e-8: far pairs need fewer quadrature points than the kernel's default.
+  const double exact = patch_form_factor(ends.receiver_polygon(), ends.emitter_polygon(), 1e-8);
+  if (!(average > 0.0) || !(exact >= 0.0)) return;
+  for (int s = 0; s < ends.ns; ++s) values.value[s] += (exact - average) * visible[s];
+}
+
 // Stores the sample form factors and the oracle's geometric criterion; false
 // when no sample sees the emitter.
-bool finish(const LinkEvaluator& evaluator, Link& link, const LinkEnds& ends, const SampleValues& values,
-            LinkTimings& timings) {
+bool finish(const LinkEvaluator& evaluator, Link& link, const LinkEnds& ends, SampleValues values,
+            bool unoccluded, LinkTimings& timings) {
   const Hierarchy& hierarchy = evaluator.hierarchy;
   const Element& receiver = hierarchy.element(link.receiver);
   const double* value = values.value;
   const dvec3* grad = values.grad;
   bool any = false;
-  for (int s = 0; s < ends.ns; ++s) {
-    link.form_factor[static_cast<size_t>(s)] = static_cast<float>(std::max(0.0, value[s]));
-    any |= value[s] > 0.0;
-  }
+  for (int s = 0; s < ends.ns; ++s) any |= value[s] > 0.0;
   if (!any) return false;
 
   // A receiver sample touching the emitter's outline (elements meeting at an
@@ -163,6 +187,14 @@ bool finish(const LinkEvaluator& evaluator, Link& link, const LinkEnds& ends, co
                       hierarchy.diameter(receiver)};
   link.oracle = used >= 2 ? static_cast<float>(oracle_geometry(evaluator.oracle, samples) / evaluator.geometric_scale) : 0.0f;
   timings.oracle += seconds_since(start);
+
+  // The oracle judged the samples' shape; what is gathered also carries the
+  // right total.
+  const auto conserve_start = Clock::now();
+  for (int s = 0; s < ends.ns; ++s) values.value[s] = std::max(0.0, values.value[s]);
+  conserve_energy(receiver, ends, unoccluded, values);
+  for (int s = 0; s < ends.ns; ++s) link.form_factor[static_cast<size_t>(s)] = static_cast<float>(values.value[s]);
+  timings.form_factors += seconds_since(conserve_start);
   return true;
 }
 
@@ -228,7 +260,7 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo)
     values.grad[s] = f.gradient;
   }
   timings.form_factors += seconds_since(start);
-  return finish(*this, link, ends, values, timings);
+  return finish(*this, link, ends, values, culling.visibility == ShaftVisibility::clear, timings);
 }
 
 void LinkEvaluator::evaluate_emitter_siblings(std::span<Link> links, LinkTimings& timings,
@@ -290,7 +322,7 @@ void LinkEvaluator::evaluate_emitter_siblings(std::span<Link> links, LinkTimings
   }
   timings.form_factors += seconds_since(start);
   for (size_t k = 0; k < facing; ++k)
-    visible[which[k]] = finish(*this, links[which[k]], ends[k], values[k], timings) ? 1 : 0;
+    visible[which[k]] = finish(*this, links[which[k]], ends[k], values[k], culling.visibility == ShaftVisibility::clear, timings) ? 1 : 0;
 }
 
 }  // namespace radiosity

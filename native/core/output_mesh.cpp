@@ -39,7 +39,9 @@ OutputMesh make_output_mesh(const Hierarchy& h,
     if (!e.is_leaf() || !shown(e.patch, e.side)) continue;
     const Rgb rho = h.reflectance(e), emission = h.emission(e);
     for (int k = 0; k < e.corner_count; ++k) {
-      const Rgb value = emission + rho * leaf_irradiance[i][static_cast<size_t>(k)];
+      // Energy-conserving link corrections (link_transport.cpp) may leave a
+      // sample a rounding below zero; light is never negative.
+      const Rgb value = emission + rho * glm::max(leaf_irradiance[i][static_cast<size_t>(k)], Rgb(0.0));
       sum[e.corner[static_cast<size_t>(k)]] += glm::dvec3(value);
       ++count[e.corner[static_cast<size_t>(k)]];
     }
@@ -74,7 +76,7 @@ OutputMesh make_output_mesh(const Hierarchy& h,
     mesh.face_sizes.push_back(static_cast<std::int32_t>(polygon.size()));
     mesh.source_face.push_back(static_cast<std::int32_t>(h.patch_of(e).face));
     mesh.source_side.push_back(e.side);
-    const Rgb mean = Interpolant::average(e.corner_count, leaf_irradiance[i]);
+    const Rgb mean = glm::max(Interpolant::average(e.corner_count, leaf_irradiance[i]), Rgb(0.0));
     mesh.irradiance.insert(mesh.irradiance.end(), {static_cast<float>(mean.x),
                                                    static_cast<float>(mean.y),
                                                    static_cast<float>(mean.z)});

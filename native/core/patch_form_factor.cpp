@@ -384,7 +384,7 @@ bool finite(std::span<const dvec3> polygon) {
 
 }  // namespace
 
-double patch_form_factor(std::span<const dvec3> p, std::span<const dvec3> q) {
+double patch_form_factor(std::span<const dvec3> p, std::span<const dvec3> q, double tolerance) {
   if (p.size() > kMaxVertices || q.size() > kMaxVertices) {
     throw std::invalid_argument("patch_form_factor: more than 16 vertices");
   }
@@ -409,11 +409,13 @@ double patch_form_factor(std::span<const dvec3> p, std::span<const dvec3> q) {
   if (gap >= 3.0 * small_radius) {
     // Error of n-point Gauss ~ rho^(-2n), rho the Bernstein ellipse reaching
     // the nearest singularity (the other polygon) at relative distance delta:
-    // rho^(-2n) < 1e-12, and one order more (measured: 1e-13 at delta = 3).
+    // rho^(-2n) < tolerance, and one order more (measured: 1e-13 at delta = 3
+    // for 1e-12).
     const double delta = gap / small_radius;
     const double rho = delta + std::sqrt(delta * delta + 1.0);
+    const double digits = -std::log(std::clamp(tolerance, 1e-15, 1e-2));
     const int order =
-        std::clamp(static_cast<int>(std::ceil(14.0 / std::log(rho))) + 1, 2, kMaxGauss);
+        std::clamp(static_cast<int>(std::ceil(0.5 * digits / std::log(rho))) + 1, 2, kMaxGauss);
     exchange = bp.radius <= bq.radius ? point_kernel_quadrature(pc, plane_p.normal, qc, order)
                                       : point_kernel_quadrature(qc, plane_q.normal, pc, order);
   } else {

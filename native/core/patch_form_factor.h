@@ -36,7 +36,8 @@ namespace radiosity {
 // normals, 3 to 16 vertices (more throws std::invalid_argument). Returns 0 when
 // nothing faces, for degenerate polygons and for non-finite input. Accurate to about
 // 1e-6 relative (1e-10 typical), including contact (shared edges or vertices),
-// coplanar polygons (0) and far-apart ones.
-double patch_form_factor(std::span<const dvec3> p, std::span<const dvec3> q);
+// coplanar polygons (0) and far-apart ones. `tolerance` sets the relative error
+// aimed at for far-apart pairs (fewer quadrature points when larger).
+double patch_form_factor(std::span<const dvec3> p, std::span<const dvec3> q, double tolerance = 1e-12);
 
 }  // namespace radiosity

@@ -395,7 +395,7 @@ Rgb push_pull_element(Hierarchy& h, std::int32_t index, const std::array<Rgb, kM
   for (size_t s = 0; s < kMaxSamples; ++s) total[s] += down[s];
   Rgb radiance;
   if (e.is_leaf()) {
-    radiance = h.emission(e) + h.reflectance(e) * Interpolant::average(e.corner_count, total);
+    radiance = h.emission(e) + h.reflectance(e) * glm::max(Interpolant::average(e.corner_count, total), Rgb(0.0));
     change.delta += std::abs(luminance(radiance) - luminance(e.radiance)) * e.area;
     change.total += luminance(radiance) * e.area;
     if (leaf_out) (*leaf_out)[static_cast<size_t>(index)] = total;
@@ -404,10 +404,20 @@ Rgb push_pull_element(Hierarchy& h, std::int32_t index, const std::array<Rgb, kM
     double area = 0.0;
     const std::int32_t first = e.first_child;
     const int corners = e.corner_count;
+    // The children's interpolants do not reproduce the parent's bubble exactly:
+    // a uniform shift makes them carry the same total, so pushing light down
+    // neither makes nor loses energy.
+    std::array<std::array<Rgb, kMaxSamples>, 4> child_down{};
+    glm::dvec3 pushed(0.0);
     for (int c = 0; c < 4; ++c) {
-      std::array<Rgb, kMaxSamples> child_down{};
-      for (int s = 0; s <= corners; ++s) child_down[static_cast<size_t>(s)] = Interpolant::at_child_sample(corners, total, c, s);
-      const Rgb child = push_pull_element(h, first + c, child_down, gather, change, leaf_out);
+      for (int s = 0; s <= corners; ++s)
+        child_down[static_cast<size_t>(c)][static_cast<size_t>(s)] = Interpolant::at_child_sample(corners, total, c, s);
+      pushed += h.element(first + c).area * glm::dvec3(Interpolant::average(corners, child_down[static_cast<size_t>(c)]));
+    }
+    const Rgb shift = Interpolant::average(corners, total) - Rgb(pushed / e.area);
+    for (int c = 0; c < 4; ++c) {
+      for (int s = 0; s <= corners; ++s) child_down[static_cast<size_t>(c)][static_cast<size_t>(s)] += shift;
+      const Rgb child = push_pull_element(h, first + c, child_down[static_cast<size_t>(c)], gather, change, leaf_out);
       const double child_area = h.element(first + c).area;
       sum += child_area * glm::dvec3(child);
       area += child_area;

@@ -87,8 +87,44 @@ class Furnace(unittest.TestCase):
         self.assertGreater(errors["none"], 0.05)
 
 
+def framed_light_box(rho):
+    """A 2 x 1.5 x 1 box, a light filling a hole in its y = 0 wall (no gap behind
+    it), a black one-sided window across the top that absorbs what escapes."""
+    b = SceneBuilder()
+    walls = b.box((0, 0, 0), (2, 1.5, 1), rho=rho, inward=True, skip=(2,))
+    b.reflectance[walls[1]] = np.full(3, 1e-9)
+    b.two_sided[walls[1]] = False
+    for x0, x1, z0, z1 in ((0, 2, 0, 0.3), (0, 2, 0.7, 1), (0, 0.5, 0.3, 0.7), (1.5, 2, 0.3, 0.7)):
+        b.polygon([(x0, 0, z0), (x0, 0, z1), (x1, 0, z1), (x1, 0, z0)], rho=rho)
+    b.polygon([(0.5, 0, 0.3), (0.5, 0, 0.7), (1.5, 0, 0.7), (1.5, 0, 0.3)], rho=1e-9, emission=(4, 3, 2),
+              two_sided=False)
+    return b
+
+
+def absorbed_power(builder, result):
+    rho = builder.arrays()["reflectance"][result.source_face]
+    return math.pi * ((1 - rho) * result.irradiance * polygon_areas(result)[:, None]).sum(axis=0)
+
+
 class EnergyBalance(unittest.TestCase):
-    @unittest.expectedFailure  # known defect, issue 5: 5-point quadrature misses near-field peaks (about 10 %)
+    def test_direct_light_is_absorbed_exactly(self):
+        # Black walls: only the light's own links carry energy. Each link's
+        # samples are corrected to the exact patch form factor, so however
+        # coarse the elements, what arrives is what the light emits.
+        b = framed_light_box(1e-9)
+        for quality in (0.0, 0.5):
+            result = rad.solve(b.scene(rad), oracle="standard", quality=quality)
+            np.testing.assert_allclose(absorbed_power(b, result), math.pi * np.array([4, 3, 2]) * 0.4, rtol=1e-6)
+
+    def test_closed_box_with_interreflection(self):
+        b = framed_light_box((0.7, 0.5, 0.3))
+        result = rad.solve(b.scene(rad), oracle="standard", quality=0.6)
+        # Without the patch form factor correction this was 10 % off; what is
+        # left (about 1.3 %) comes from emitters linked at a coarser level than
+        # their radiance varies on (tested below at the issue's 1e-3).
+        np.testing.assert_allclose(absorbed_power(b, result), math.pi * np.array([4, 3, 2]) * 0.4, rtol=0.03)
+
+    @unittest.expectedFailure  # known defect, issue 5: about 1.3 % short, see test_closed_box_with_interreflection
     def test_open_box_emitted_equals_absorbed_plus_escaped(self):
         # A box open at the top, a light on one wall; a black "window" across the
         # opening (rho ~ 0, one-sided, facing in) measures the power that escapes.
