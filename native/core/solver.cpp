@@ -231,6 +231,8 @@ void Solver::link_initially() {
     report("linking", 0.1 * static_cast<double>(end) / static_cast<double>(receivers.size()));
   }
   for (const Link& l : links_) hierarchy_.element(l.receiver).has_links = 1;
+  links_.shrink_to_fit();
+  hierarchy_.shrink_to_fit();
   ++links_version_;
   stats_.seconds_linking = std::chrono::duration<double>(Clock::now() - start).count();
   track_memory();
