@@ -229,6 +229,8 @@ def main():
     import study_figures
     import study_plots
     import study_report
+    for stale in out.glob("study_compare_*.png"):   # scenes of an earlier run in another mode
+        stale.unlink()
     plots = study_plots.plot_all(studies, out)
     figures = study_figures.comparison_figures(rad, studies, out)
     study_report.write(out / "report.md", studies, settings, plots, figures,
