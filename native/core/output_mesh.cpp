@@ -21,13 +21,15 @@ OutputMesh make_output_mesh(const Hierarchy& h,
   const auto& elements = h.elements();
   const Scene& scene = h.scene();
 
-  // A side is shown when light reaches it; a face that no light reaches shows
-  // its front, dark, so the geometry stays whole.
+  // A side is shown when light reaches it or it emits (the back of a two-sided
+  // lamp seen from above); a face that no light reaches shows its front, dark,
+  // so the geometry stays whole.
   std::vector<std::uint8_t> lit(2 * scene.patches.size(), 0);
   for (const Element& e : elements) lit[2 * e.patch + e.side] |= e.has_links;
   const auto shown = [&](std::uint32_t patch, int side) {
     if (h.root(patch, side) == kNone) return false;
     if (lit[2 * patch + static_cast<size_t>(side)]) return true;
+    if (luminance(scene.patches[patch].emission) > 0.0) return true;
     return side == 0 && !lit[2 * patch + 1];
   };
 

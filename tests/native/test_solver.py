@@ -150,6 +150,22 @@ class EnergyBalance(unittest.TestCase):
         self.assertTrue(np.all(escaped > 0.05 * emitted), "the opening lets light out")
 
 
+class EmitterSides(unittest.TestCase):
+    def test_both_sides_of_a_two_sided_black_lamp_are_shown_emitting(self):
+        # A lamp that reflects nothing receives no links, yet both its sides
+        # emit: the output must show both (a camera above a pendant lamp sees
+        # its back), at its emitted radiance.
+        b = SceneBuilder()
+        b.box((0, 0, 0), (4, 4, 3), rho=0.6, inward=True)
+        lamp = b.polygon([(1.5, 1.5, 2), (2.5, 1.5, 2), (2.5, 2.5, 2), (1.5, 2.5, 2)], rho=0.0,
+                         emission=(5, 4, 3), two_sided=True)
+        result = rad.solve(b.scene(rad), oracle="standard", quality=0.2)
+        polygons_of_lamp = result.source_face == lamp
+        self.assertEqual(set(result.source_side[polygons_of_lamp].tolist()), {0, 1})
+        vertices = np.unique(np.concatenate([poly for poly, keep in zip(polygons(result), polygons_of_lamp) if keep]))
+        np.testing.assert_allclose(result.radiance[vertices], np.tile([5, 4, 3], (len(vertices), 1)), rtol=1e-6)
+
+
 class TwoFacingSquares(unittest.TestCase):
     def test_gathered_radiance_matches_closed_form(self):
         for distance in (0.5, 1.0, 3.0):
