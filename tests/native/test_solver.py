@@ -45,8 +45,12 @@ def parallel_squares_form_factor(a, c):
 
 
 def closed_box(rho, emission):
+    """The furnace: the inside of a closed box. One-sided, so the unlit outside
+    (which emits too, and would be shown at L_e) is not part of the output."""
     b = SceneBuilder()
-    b.box((0, 0, 0), (1, 1.3, 0.8), rho=rho, emission=emission, inward=True)
+    faces = b.box((0, 0, 0), (1, 1.3, 0.8), rho=rho, emission=emission, inward=True)
+    for f in faces:
+        b.two_sided[f] = False
     return b
 
 
