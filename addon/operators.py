@@ -51,9 +51,14 @@ class Job:
     started: float = field(default_factory=time.perf_counter)
 
 
-def native_options(options):
-    """scene.radiosity.solver_options() in the form rad.solve takes (0 = no limit)."""
-    return {
+def native_options(options, total_area):
+    """scene.radiosity.solver_options() in the form rad.solve takes (0 = no limit or
+    automatic); the smallest element's edge becomes a fraction of the scene's area."""
+    extra = {}
+    size = float(options.get("min_element_size", 0.0))
+    if size > 0.0 and total_area > 0.0:
+        extra["min_element_area"] = min(size * size / total_area, 0.5)
+    return extra | {
         "oracle": options["oracle"],
         "quality": float(options["quality"]),
         "max_elements": int(options["max_elements"]) or None,
@@ -219,7 +224,8 @@ class RADIOSITY_OT_solve(Operator):
         settings = scene.radiosity
         label = settings.bl_rna.properties["oracle"].enum_items[settings.oracle].name
         return Job(scene_name=scene.name, exported=exported, native_scene=native_scene,
-                   options=native_options(settings.solver_options()), oracle_label=label)
+                   options=native_options(settings.solver_options(), native_scene.total_area),
+                   oracle_label=label)
 
     def _conclude(self, context, job):
         """Report a finished job's error, or bake its result (main thread)."""

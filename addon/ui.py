@@ -35,6 +35,7 @@ class RENDER_PT_radiosity(Panel):
         col.prop(settings, "max_elements")
         col.prop(settings, "time_budget")
         col.prop(settings, "bounces")
+        col.prop(settings, "min_element_size")
 
         col = layout.column()
         col.prop(settings, "visibility")

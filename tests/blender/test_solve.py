@@ -67,6 +67,17 @@ def luminance(rgb):
 
 
 class SolveCubeTest(unittest.TestCase):
+    def test_smallest_element_bounds_refinement(self):
+        counts = {}
+        for size in (0.0, 0.5):
+            scene = open_scene("cube")
+            scene.radiosity.oracle = 'PERCEPTUAL'
+            scene.radiosity.quality = 0.8
+            scene.radiosity.min_element_size = size
+            self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
+            counts[size] = scene.radiosity.stats.elements
+        self.assertLess(counts[0.5], counts[0.0] / 2)
+
     def test_every_oracle(self):
         for oracle in ('STANDARD', 'PERCEPTUAL', 'GRADIENT'):
             with self.subTest(oracle=oracle):
