@@ -86,7 +86,6 @@ struct LinkEnds {
   dvec3 n{0.0};
   std::span<const dvec3> receiver_polygon() const { return {receiver_corners, static_cast<size_t>(nr)}; }
   std::span<const dvec3> emitter_polygon() const { return {emitter_corners, static_cast<size_t>(ne)}; }
-  std::span<const dvec3> samples() const { return {x, static_cast<size_t>(ns)}; }
 };
 
 LinkEnds link_ends(const Hierarchy& h, const Element& receiver, const Element& emitter) {

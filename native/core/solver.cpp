@@ -131,7 +131,7 @@ std::vector<Link> Solver::evaluate_links(std::vector<Link>&& candidates) {
   enum class Run : std::uint8_t { Single, SiblingReceivers, SiblingEmitters };
   const auto parent = [&](std::int32_t e) { return hierarchy_.element(e).parent; };
   const auto run_of = [&](const Link& a, const Link& b) {
-    // Roots (no parent) of different faces may share vertices but not normals.
+    // Roots have no parent: they never come from one split.
     if (a.emitter == b.emitter && parent(a.receiver) != kNone && parent(a.receiver) == parent(b.receiver))
       return Run::SiblingReceivers;
     if (a.receiver == b.receiver && parent(a.emitter) != kNone && parent(a.emitter) == parent(b.emitter))
