@@ -16,6 +16,9 @@ import sys
 import addon_utils
 import bpy
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "scenes"))
+from scene_kit import make_lambertian  # noqa: E402
+
 TAG = "[study] "
 BOUNCES = ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces", "volume_bounces",
            "transparent_max_bounces")
@@ -37,23 +40,6 @@ def enable_addon(addon_dir):
         raise err
 
     addon_utils.enable("radiosity", default_set=False, handle_error=fail)
-
-
-def make_lambertian(material):
-    """Replace a Principled BSDF by a Diffuse BSDF of its base colour: Cycles'
-    Principled diffuse is not Lambertian, the radiosity model is (as in the
-    Cycles agreement tests). Emission-only materials stay as they are."""
-    if not material.use_nodes:
-        return
-    nodes, links = material.node_tree.nodes, material.node_tree.links
-    bsdf = next((n for n in nodes if n.type == 'BSDF_PRINCIPLED'), None)
-    if bsdf is None:
-        return
-    output = next(n for n in nodes if n.type == 'OUTPUT_MATERIAL')
-    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Color"].default_value = bsdf.inputs["Base Color"].default_value
-    nodes.remove(bsdf)
-    links.new(diffuse.outputs["BSDF"], output.inputs["Surface"])
 
 
 def lambertian_scene():

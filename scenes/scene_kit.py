@@ -183,3 +183,20 @@ def setup_render(scene, resolution=(640, 480), samples=128):
     world.use_nodes = True
     world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
     scene.world = world
+
+
+def make_lambertian(material):
+    """Replace a Principled BSDF by a Diffuse BSDF of its base colour: Cycles'
+    Principled diffuse is not Lambertian, the radiosity model is, so comparisons
+    with Cycles use this. Emission-only materials stay as they are."""
+    if not material.use_nodes:
+        return
+    nodes, links = material.node_tree.nodes, material.node_tree.links
+    bsdf = next((n for n in nodes if n.type == 'BSDF_PRINCIPLED'), None)
+    if bsdf is None:
+        return
+    output = next(n for n in nodes if n.type == 'OUTPUT_MATERIAL')
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = bsdf.inputs["Base Color"].default_value
+    nodes.remove(bsdf)
+    links.new(diffuse.outputs["BSDF"], output.inputs["Surface"])

@@ -1,4 +1,4 @@
-"""Helpers of the Cycles agreement tests: diffuse-only materials, small renders, region statistics.
+"""Helpers of the Cycles agreement tests: small renders, region statistics.
 
 A radiosity solution is compared with a path-traced Cycles render of the same
 scene from the same camera (Standard view transform): the solution is rendered
@@ -16,23 +16,6 @@ import bpy
 import numpy as np
 
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
-
-
-def make_diffuse(material):
-    """Replace a Principled BSDF by a Diffuse BSDF of the same colour (Lambertian,
-    like the radiosity model; Cycles' Principled diffuse is not) and keep emission
-    materials as they are."""
-    if not material.use_nodes:
-        return
-    nodes, links = material.node_tree.nodes, material.node_tree.links
-    bsdf = next((n for n in nodes if n.type == 'BSDF_PRINCIPLED'), None)
-    if bsdf is None:
-        return
-    output = next(n for n in nodes if n.type == 'OUTPUT_MATERIAL')
-    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Color"].default_value = bsdf.inputs["Base Color"].default_value
-    nodes.remove(bsdf)
-    links.new(diffuse.outputs["BSDF"], output.inputs["Surface"])
 
 
 def render_image(scene, samples, resolution=(96, 72)):

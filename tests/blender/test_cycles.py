@@ -94,7 +94,7 @@ class CyclesAgreementTest(unittest.TestCase):
     def test_cube(self):
         scene = open_scene("cube")
         for mat in bpy.data.materials:
-            rc.make_diffuse(mat)
+            kit.make_lambertian(mat)
         self.agree(scene, "cube")
 
     def test_area_light(self):
