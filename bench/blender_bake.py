@@ -13,8 +13,6 @@ JOBS.json: {"width", "height", "render_samples", "pairs": [[target vertices, bak
 samples, bake_seconds (the bake operator alone) and the snapshot's EXR.
 """
 
-import argparse
-import json
 import os
 import sys
 import time
@@ -105,17 +103,10 @@ def bake(scene, obj, samples):
 
 
 def main():
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--addon", required=True)
-    parser.add_argument("--jobs", required=True)
-    args = common.arguments(parser)
-    with open(args.jobs) as f:
-        jobs = json.load(f)
-    common.enable_addon(args.addon)
+    jobs = common.start_jobs()
     from radiosity import export
 
     scene = bpy.context.scene
-    common.lambertian_scene()
     arrays = export.export_scene(bpy.context).arrays
     # Only the rebuilt scene takes part from here on.
     for obj in list(scene.objects):

@@ -42,6 +42,20 @@ def enable_addon(addon_dir):
     addon_utils.enable("radiosity", default_set=False, handle_error=fail)
 
 
+def start_jobs():
+    """The common start of a jobs script: --addon and --jobs after `--`, the add-on
+    enabled, the scene's materials made Lambertian; returns the jobs (a dict)."""
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--addon", required=True)
+    parser.add_argument("--jobs", required=True)
+    args = arguments(parser)
+    with open(args.jobs) as f:
+        jobs = json.load(f)
+    enable_addon(args.addon)
+    lambertian_scene()
+    return jobs
+
+
 def lambertian_scene():
     for material in bpy.data.materials:
         make_lambertian(material)

@@ -17,8 +17,6 @@ JOBS.json: {"width", "height", "samples", "camera": OUT.json (optional),
 - "camera" receives the world -> pixel projection (blender_common.camera_projection).
 """
 
-import argparse
-import json
 import os
 import sys
 import time
@@ -104,17 +102,10 @@ def render_solutions(scene, jobs, exported, projection):
 
 
 def main():
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--addon", required=True)
-    parser.add_argument("--jobs", required=True)
-    args = common.arguments(parser)
-    with open(args.jobs) as f:
-        jobs = json.load(f)
-    common.enable_addon(args.addon)
+    jobs = common.start_jobs()
     from radiosity import bake, export
 
     scene = bpy.context.scene
-    common.lambertian_scene()
     width, height = jobs["width"], jobs["height"]
     # Path-traced settings first: the references need the scene's own bounces.
     common.setup_render(scene, width, height, jobs.get("samples", 16), path_traced=True)
