@@ -369,6 +369,31 @@ bool project_occluder(std::span<const dvec3> poly, Workspace& w) {
   return clean_tail(w.occluder, 0, w.tol);
 }
 
+// Signed distances of `poly`'s vertices to h, in w.dist. True when a vertex
+// lies outside by more than the tolerance, i.e. h cuts the polygon.
+bool cuts(Workspace& w, std::span<const PlaneVertex> poly, const HalfPlane& h) {
+  w.dist.resize(poly.size());
+  bool any_out = false;
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    w.dist[i] = h.distance(poly[i].p);
+    any_out = any_out || w.dist[i] < -w.tol.plane;
+  }
+  return any_out;
+}
+
+// Keeps the part of w.rest inside h (distances from cuts()). False, with
+// w.rest emptied, when nothing of positive area is left.
+bool keep_inside(Workspace& w, const HalfPlane& h) {
+  w.inside.clear();
+  clip_tagged<PlaneVertex>(w.rest, w.dist, +1, w.tol.plane, h.line, lerp_plane, w.inside);
+  if (!clean_tail(w.inside, 0, w.tol)) {
+    w.rest.clear();
+    return false;
+  }
+  std::swap(w.rest, w.inside);
+  return true;
+}
+
 // Subtracts the convex w.occluder from every piece (successive half-planes,
 // DESIGN.md 4): the parts of a piece outside each edge in turn are kept, what
 // is left inside all edges is hidden.
@@ -403,23 +428,11 @@ void subtract_occluder(Workspace& w) {
     }
     w.rest.assign(p.begin(), p.end());
     for (const HalfPlane& h : w.halves) {
-      w.dist.resize(w.rest.size());
-      bool any_out = false;
-      for (std::size_t i = 0; i < w.rest.size(); ++i) {
-        w.dist[i] = h.distance(w.rest[i].p);
-        any_out = any_out || w.dist[i] < -w.tol.plane;
-      }
-      if (!any_out) continue;  // the rest lies inside this half-plane: no cut
+      if (!cuts(w, w.rest, h)) continue;  // the rest lies inside this half-plane: no cut
       const std::size_t first = w.next_pieces.size();
       clip_tagged<PlaneVertex>(w.rest, w.dist, -1, w.tol.plane, h.line, lerp_plane, w.next_pieces);
       if (clean_tail(w.next_pieces, first, w.tol)) close_piece();
-      w.inside.clear();
-      clip_tagged<PlaneVertex>(w.rest, w.dist, +1, w.tol.plane, h.line, lerp_plane, w.inside);
-      if (!clean_tail(w.inside, 0, w.tol)) {
-        w.rest.clear();
-        break;
-      }
-      std::swap(w.rest, w.inside);
+      if (!keep_inside(w, h)) break;
     }
     // What is left of the piece lies inside the occluder: hidden.
   }
@@ -468,13 +481,7 @@ bool setup(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter, Works
     horizon.line.direction = w.frame.to_space(dvec2(-h.w.y, h.w.x)) - w.frame.origin;
     horizon.line.point = w.frame.to_space(-h.c * h.w);
     h.line = w.add_line(horizon);
-    w.dist.resize(k);
-    bool any_below = false;
-    for (std::size_t i = 0; i < k; ++i) {
-      w.dist[i] = h.distance(w.emitter[i].p);
-      any_below = any_below || w.dist[i] < -w.tol.plane;
-    }
-    if (any_below) {
+    if (cuts(w, w.emitter, h)) {
       w.inside.clear();
       clip_tagged<PlaneVertex>(w.emitter, w.dist, +1, w.tol.plane, h.line, lerp_plane, w.inside);
       std::swap(w.emitter, w.inside);
@@ -614,20 +621,7 @@ FormFactorGradient part_form_factor_gradient(Workspace& w, std::span<const dvec3
     const std::span<const PlaneVertex> p = piece(w, i);
     w.rest.assign(p.begin(), p.end());
     for (const HalfPlane& h : w.halves) {
-      w.dist.resize(w.rest.size());
-      bool any_out = false;
-      for (std::size_t k = 0; k < w.rest.size(); ++k) {
-        w.dist[k] = h.distance(w.rest[k].p);
-        any_out = any_out || w.dist[k] < -w.tol.plane;
-      }
-      if (!any_out) continue;
-      w.inside.clear();
-      clip_tagged<PlaneVertex>(w.rest, w.dist, +1, w.tol.plane, h.line, lerp_plane, w.inside);
-      if (!clean_tail(w.inside, 0, w.tol)) {
-        w.rest.clear();
-        break;
-      }
-      std::swap(w.rest, w.inside);
+      if (cuts(w, w.rest, h) && !keep_inside(w, h)) break;
     }
     if (!w.rest.empty()) total.add(form_factor_gradient(w.r, w.n, contour_of(w, w.rest)));
   }
