@@ -124,23 +124,27 @@ FormFactorGradient unoccluded(const LinkEvaluator& evaluator, const dvec3& x, co
 // average (the interpolant's, which is what the receiver absorbs). The fix is
 // additive, delta = F_pq - average: at a sample that sees all of a closed scene
 // through links of one level, the form factors still sum to one (the deltas of
-// those links sum to zero), so the furnace stays exact. It is scaled by each
-// sample's visible fraction, so hidden samples stay dark. A sample can end a
-// little below zero where F falls steeply; the gather's sum is what matters and
-// the output clamps at zero.
+// those links sum to zero), so the furnace stays exact. It goes only to the
+// samples in front of the emitter's plane (F_pq counts only that part of the
+// receiver; samples behind it stay dark, and the others carry the whole
+// delta), scaled by each one's visible fraction, so hidden samples stay dark.
+// A sample can end a little below zero where F falls steeply; the gather's sum
+// is what matters and the output clamps at zero.
 void conserve_energy(const Element& receiver, const LinkEnds& ends, bool unoccluded, SampleValues& values) {
-  std::array<Rgb, kMaxSamples> open{};
+  std::array<Rgb, kMaxSamples> open{}, in_front{};
   double visible[kMaxSamples] = {};
   for (int s = 0; s < ends.ns; ++s) {
     const double f = unoccluded ? values.value[s] : form_factor(ends.x[s], ends.n, ends.emitter_polygon());
     open[static_cast<size_t>(s)] = Rgb(f);
+    in_front[static_cast<size_t>(s)] = Rgb(f > 0.0 ? 1.0 : 0.0);
     visible[s] = f > 0.0 ? std::clamp(values.value[s] / f, 0.0, 1.0) : 0.0;
   }
   const double average = Interpolant::average(receiver.corner_count, open).x;
+  const double front = Interpolant::average(receiver.corner_count, in_front).x;
   // 1e-8: far pairs need fewer quadrature points than the kernel's default.
   const double exact = patch_form_factor(ends.receiver_polygon(), ends.emitter_polygon(), 1e-8);
-  if (!(average > 0.0) || !(exact >= 0.0)) return;
-  for (int s = 0; s < ends.ns; ++s) values.value[s] += (exact - average) * visible[s];
+  if (!(average > 0.0) || !(exact >= 0.0) || !(front > 0.0)) return;
+  for (int s = 0; s < ends.ns; ++s) values.value[s] += (exact - average) * visible[s] / front;
 }
 
 // Stores the sample form factors and the oracle's geometric criterion; false

@@ -9,6 +9,7 @@
 #include <memory>
 #include <span>
 
+#include "core/emitter_shape.h"
 #include "core/form_factor.h"
 #include "core/hierarchy.h"
 #include "core/oracle.h"
@@ -26,6 +27,9 @@ struct Link {
   // Geometric part of the refinement criterion over the oracle's geometric
   // scale (oracle_geometric_scale): dimensionless.
   float oracle = 0.0f;
+  // How F varies over the emitter (emitter_shape.h), so a split emitter sends
+  // more from where it sees the receiver better. Computed once the emitter is split.
+  EmitterShape emitter_shape = kShapeNotComputed;
 };
 
 // CPU seconds spent in each part of link evaluation (summed over threads), and

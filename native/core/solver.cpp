@@ -67,7 +67,7 @@ class Solver {
   bool refine(double threshold);
   Split choose_split(const Link& link, double threshold) const;
   bool can_split(std::int32_t e) const { return hierarchy_.element(e).area / 4.0 >= min_area_; }
-  bool near_field(const Link& link) const;
+  bool near_field(const Link& link, bool receiver_end) const;
   void group_links();
   double gather_push_pull();
   double iterate(double threshold, int max_iterations, double tolerance);
@@ -238,16 +238,16 @@ void Solver::link_initially() {
   track_memory();
 }
 
-// An emitter closer to the receiver than the receiver's own size: the form
-// factor may vary between the receiver's samples in ways its interpolant
-// cannot follow (it grows quickly towards a shared edge), so such links follow
-// a split receiver down instead of being interpolated.
-bool Solver::near_field(const Link& link) const {
+// Is one end of the link closer to the other than twice its own radius? Then
+// the form factor varies over that end in ways five samples (receiver) or a
+// split in four (emitter shape) cannot follow: it grows quickly towards a
+// shared edge. Such links follow a split end down instead.
+bool Solver::near_field(const Link& link, bool receiver_end) const {
   const Element& p = hierarchy_.element(link.receiver);
   const Element& q = hierarchy_.element(link.emitter);
   const double rp = 0.5 * hierarchy_.diameter(p), rq = 0.5 * hierarchy_.diameter(q);
   const double gap = glm::length(hierarchy_.centre(p) - hierarchy_.centre(q)) - rp - rq;
-  return gap < 2.0 * rp;
+  return gap < 2.0 * (receiver_end ? rp : rq);
 }
 
 // The refinement policy shared by every oracle (DESIGN s5): split the larger
@@ -300,22 +300,29 @@ bool Solver::refine(double threshold) {
       kept.push_back(link);
     }
     if (options_.leaf_links != SolveOptions::LeafLinks::None) {
-      // A split receiver hands all its links down, so every sample's value is
-      // gathered exactly, never interpolated from a coarser element. Fresh
-      // links too: their receiver may have been split by another link.
+      // A split receiver hands its links down, so its samples' values are
+      // gathered, not interpolated from a coarser element: near-field links
+      // ("near"), or all of them ("all"), which also hands near-field links
+      // from a split emitter down to its children, so that they send what
+      // each part of the emitter reflects. Fresh links too: their ends may
+      // have been split by another link.
+      const bool all = options_.leaf_links == SolveOptions::LeafLinks::All;
       const auto hand_down = [&](std::vector<Link>& links, std::vector<Link>& staying,
                                  std::vector<Link>& moved) {
         for (const Link& link : links) {
           const Element& receiver = hierarchy_.element(link.receiver);
-          if (receiver.is_leaf() ||
-              (options_.leaf_links == SolveOptions::LeafLinks::Near && !near_field(link))) {
+          const Element& emitter = hierarchy_.element(link.emitter);
+          const bool receiver_down = !receiver.is_leaf() && (all || near_field(link, true));
+          const bool emitter_down = !receiver_down && all && !emitter.is_leaf() && near_field(link, false);
+          if (!receiver_down && !emitter_down) {
             staying.push_back(link);
             continue;
           }
-          for (std::int32_t c = receiver.first_child; c < receiver.first_child + 4; ++c) {
+          const std::int32_t first = receiver_down ? receiver.first_child : emitter.first_child;
+          for (std::int32_t c = first; c < first + 4; ++c) {
             Link l;
-            l.receiver = c;
-            l.emitter = link.emitter;
+            l.receiver = receiver_down ? c : link.receiver;
+            l.emitter = receiver_down ? link.emitter : c;
             moved.push_back(l);
           }
         }
@@ -359,6 +366,17 @@ void Solver::group_links() {
   order_.shrink_to_fit();
   std::vector<std::uint32_t> next(offset_.begin(), offset_.end() - 1);
   for (std::uint32_t i = 0; i < links_.size(); ++i) order_[next[static_cast<size_t>(links_[i].receiver)]++] = i;
+  // Only links whose emitter has been split need its shape.
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, links_.size()), [&](const auto& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      Link& l = links_[i];
+      const Element& emitter = hierarchy_.element(l.emitter);
+      if (emitter.is_leaf() || shape_computed(l.emitter_shape)) continue;
+      dvec3 receiver[4];
+      const int n = hierarchy_.corners(hierarchy_.element(l.receiver), receiver);
+      l.emitter_shape = emitter_shape(hierarchy_, emitter, std::span<const dvec3>(receiver, static_cast<size_t>(n)));
+    }
+  });
   grouped_version_ = links_version_;
 }
 
@@ -367,6 +385,7 @@ void Solver::group_links() {
 // the result does not depend on the order elements are visited in. Computed
 // where push/pull needs it instead of stored per element.
 struct LinkGather {
+  const Hierarchy& hierarchy;
   const std::vector<Link>& links;
   const std::vector<std::uint32_t>& offset;
   const std::vector<std::uint32_t>& order;
@@ -376,7 +395,7 @@ struct LinkGather {
     std::array<Rgb, kMaxSamples> h{};
     for (std::uint32_t k = offset[static_cast<size_t>(e)]; k < offset[static_cast<size_t>(e) + 1]; ++k) {
       const Link& l = links[order[k]];
-      const Rgb& radiance = source[static_cast<size_t>(l.emitter)];
+      const Rgb radiance = sent_radiance(hierarchy, l.emitter, source, l.emitter_shape);
       for (size_t s = 0; s < kMaxSamples; ++s) h[s] += static_cast<double>(l.form_factor[s]) * radiance;
     }
     return h;
@@ -453,7 +472,7 @@ double Solver::gather_push_pull() {
   tbb::parallel_for(tbb::blocked_range<size_t>(0, elements.size()), [&](const auto& range) {
     for (size_t e = range.begin(); e != range.end(); ++e) source_[e] = elements[e].radiance;
   });
-  return push_pull_all(hierarchy_, LinkGather{links_, offset_, order_, source_}, nullptr);
+  return push_pull_all(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, nullptr);
 }
 
 
@@ -492,7 +511,7 @@ void Solver::snapshot(double threshold) {
   std::vector<std::array<Rgb, kMaxSamples>> leaf(hierarchy_.elements().size());
   source_.resize(hierarchy_.elements().size(), Rgb(0.0));
   group_links();
-  push_pull_all(hierarchy_, LinkGather{links_, offset_, order_, source_}, &leaf);
+  push_pull_all(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, &leaf);
   result_.mesh = make_output_mesh(hierarchy_, leaf);
   stats_.threshold = threshold;
 }

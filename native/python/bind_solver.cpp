@@ -267,7 +267,7 @@ void bind_solver(py::module_& m) {
         "[0, 1] (0: no refinement); max_elements, time_budget (s): budgets; visibility:\n"
         "'exact' | 'sampled' (rays per sample); bounces: fixed iteration count instead of\n"
         "convergence; threads; progress(dict) callback; cancel: CancelToken;\n"
-        "leaf_links: 'near' | 'all' | 'none', which links follow a split receiver down.");
+        "leaf_links: 'near' | 'all' | 'none', which links follow a split end down ('all': energy to 1e-3).");
   m.def("quality_threshold", [](const std::string& oracle, double quality) {
     return quality_threshold(read_oracle(oracle), quality);
   }, py::arg("oracle"), py::arg("quality"), "The oracle's refinement threshold at a quality level.");

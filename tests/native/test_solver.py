@@ -92,8 +92,9 @@ class Furnace(unittest.TestCase):
 
 
 def framed_light_box(rho):
-    """A 2 x 1.5 x 1 box, a light filling a hole in its y = 0 wall (no gap behind
-    it), a black one-sided window across the top that absorbs what escapes."""
+    """A 2 x 1.5 x 1 box open at the top, a light filling a hole in its y = 0
+    wall (no gap behind it), a black one-sided window across the opening that
+    absorbs what escapes."""
     b = SceneBuilder()
     walls = b.box((0, 0, 0), (2, 1.5, 1), rho=rho, inward=True, skip=(2,))
     b.reflectance[walls[1]] = np.full(3, 1e-9)
@@ -102,56 +103,70 @@ def framed_light_box(rho):
         b.polygon([(x0, 0, z0), (x0, 0, z1), (x1, 0, z1), (x1, 0, z0)], rho=rho)
     b.polygon([(0.5, 0, 0.3), (0.5, 0, 0.7), (1.5, 0, 0.7), (1.5, 0, 0.3)], rho=1e-9, emission=(4, 3, 2),
               two_sided=False)
+    return b, walls[1]
+
+
+def floating_light_box(rho, gap):
+    """The same open box with a whole y = 0 wall, the light `gap` in front of
+    it: the light hides part of that wall from the rest of the box."""
+    b = SceneBuilder()
+    walls = b.box((0, 0, 0), (2, 1.5, 1), rho=rho, inward=True)
+    b.reflectance[walls[1]] = np.full(3, 1e-9)
+    b.two_sided[walls[1]] = False
+    b.polygon([(0.5, gap, 0.3), (0.5, gap, 0.7), (1.5, gap, 0.7), (1.5, gap, 0.3)], rho=1e-9,
+              emission=(4, 3, 2), two_sided=False)
     return b
 
 
-def absorbed_power(builder, result):
+LIGHT_POWER = math.pi * np.array([4, 3, 2]) * 0.4
+
+
+def absorbed_power(builder, result, faces=None):
     rho = builder.arrays()["reflectance"][result.source_face]
-    return math.pi * ((1 - rho) * result.irradiance * polygon_areas(result)[:, None]).sum(axis=0)
+    absorbed = math.pi * ((1 - rho) * result.irradiance * polygon_areas(result)[:, None])
+    return absorbed.sum(axis=0) if faces is None else absorbed[np.isin(result.source_face, faces)].sum(axis=0)
 
 
 class EnergyBalance(unittest.TestCase):
     def test_direct_light_is_absorbed_exactly(self):
         # Black walls: only the light's own links carry energy. Each link's
         # samples are corrected to the exact patch form factor, so however
-        # coarse the elements, what arrives is what the light emits.
-        b = framed_light_box(1e-9)
-        for quality in (0.0, 0.5):
-            result = rad.solve(b.scene(rad), oracle="standard", quality=quality)
-            np.testing.assert_allclose(absorbed_power(b, result), math.pi * np.array([4, 3, 2]) * 0.4, rtol=1e-6)
+        # coarse the elements, what arrives is what the light emits. A light
+        # floating in front of a wall leaves the samples of the walls it meets
+        # behind its plane dark; the others carry the whole correction.
+        for b in (framed_light_box(1e-9)[0], floating_light_box(1e-9, 1e-3), floating_light_box(1e-9, 0.3)):
+            for quality in (0.0, 0.5):
+                result = rad.solve(b.scene(rad), oracle="standard", quality=quality)
+                np.testing.assert_allclose(absorbed_power(b, result), LIGHT_POWER, rtol=1e-6)
 
-    def test_closed_box_with_interreflection(self):
-        b = framed_light_box((0.7, 0.5, 0.3))
-        result = rad.solve(b.scene(rad), oracle="standard", quality=0.6)
-        # Without the patch form factor correction this was 10 % off; what is
-        # left (about 1.3 %) comes from emitters linked at a coarser level than
-        # their radiance varies on (tested below at the issue's 1e-3).
-        np.testing.assert_allclose(absorbed_power(b, result), math.pi * np.array([4, 3, 2]) * 0.4, rtol=0.03)
-
-    @unittest.expectedFailure  # known defect, issue 5: about 1.3 % short, see test_closed_box_with_interreflection
     def test_open_box_emitted_equals_absorbed_plus_escaped(self):
-        # A box open at the top, a light on one wall; a black "window" across the
-        # opening (rho ~ 0, one-sided, facing in) measures the power that escapes.
-        b = SceneBuilder()
-        walls = b.box((0, 0, 0), (2, 1.5, 1), rho=(0.7, 0.5, 0.3), inward=True)
-        top = walls[1]
-        b.reflectance[top] = np.full(3, 1e-9)
-        b.two_sided[top] = False
-        # The light faces into the box (+y); barely reflective, so the solver
-        # also computes what it absorbs.
-        light = b.polygon([(0.5, 1e-3, 0.3), (0.5, 1e-3, 0.7), (1.5, 1e-3, 0.7), (1.5, 1e-3, 0.3)],
-                          rho=1e-9, emission=(4, 3, 2), two_sided=False)
-        scene = b.scene(rad)
-        result = rad.solve(scene, oracle="standard", quality=0.6)
-        areas = polygon_areas(result)
-        a = b.arrays()
-        rho = a["reflectance"][result.source_face]
-        absorbed = math.pi * ((1 - rho) * result.irradiance * areas[:, None]).sum(axis=0)
-        light_area = 0.4
-        emitted = math.pi * np.array([4, 3, 2]) * light_area
-        np.testing.assert_allclose(absorbed, emitted, rtol=1e-3)
-        escaped = (math.pi * result.irradiance * areas[:, None])[result.source_face == top].sum(axis=0)
-        self.assertTrue(np.all(escaped > 0.05 * emitted), "the opening lets light out")
+        # leaf_links="all" hands near-field links down at both ends, so every
+        # part of a coarse emitter sends what it reflects: energy is conserved
+        # to the issue's 1e-3. The default ("near", receivers only) trades
+        # about 1 % of the interreflected light for 3 to 5 times fewer links;
+        # before each link kept its shape over the emitter it lost 1.3 %.
+        b, window = framed_light_box((0.7, 0.5, 0.3))
+        for mode, rtol in (("all", 1e-3), ("near", 0.012)):
+            with self.subTest(leaf_links=mode):
+                result = rad.solve(b.scene(rad), oracle="standard", quality=0.6, leaf_links=mode)
+                escaped = absorbed_power(b, result, [window])
+                walls = absorbed_power(b, result) - escaped
+                np.testing.assert_allclose(walls + escaped, LIGHT_POWER, rtol=rtol)
+                self.assertTrue(np.all(escaped > 0.05 * LIGHT_POWER), "the opening lets light out")
+                self.assertTrue(np.all(walls > 0.2 * LIGHT_POWER), "the walls absorb a good part")
+
+    def test_light_hiding_a_wall_loses_what_its_shadow_samples_miss(self):
+        # Where the light hides part of a wall, what the wall gathers is the
+        # visible form factor at five samples, interpolated: not the exact
+        # visible area-to-area exchange, so energy is conserved only as the
+        # shadow's outline is refined (native/README.md, known limits).
+        b = floating_light_box((0.7, 0.5, 0.3), 0.3)
+        error = {}
+        for quality in (0.0, 0.6):
+            result = rad.solve(b.scene(rad), oracle="standard", quality=quality, leaf_links="all")
+            error[quality] = np.abs(absorbed_power(b, result) / LIGHT_POWER - 1).max()
+        self.assertLess(error[0.6], 0.02)
+        self.assertLess(error[0.6], 0.5 * error[0.0])
 
 
 class EmitterSides(unittest.TestCase):
