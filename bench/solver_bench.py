@@ -24,7 +24,7 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests" / "native"))
 sys.path.insert(0, str(ROOT / "scenes"))
 sys.path.insert(0, str(ROOT / "bench"))
-from synthetic_scenes import SceneBuilder, room_with_blocker  # noqa: E402
+from synthetic_scenes import SceneBuilder, box_field, room_with_blocker  # noqa: E402
 
 BUNDLED = ("cube", "office", "full_office", "dining_room")
 ORACLES = ("standard", "perceptual", "gradient")
@@ -69,26 +69,6 @@ def office(b=None):
     for x, y in ((1.85, 1.45), (3.1, 1.45), (1.85, 2.5), (3.1, 2.5)):
         b.box((x, y, 0.0), (x + 0.05, y + 0.05, 0.72), rho=0.3)
     b.box((0.2, 3.3, 0.0), (1.4, 3.9, 1.8), rho=(0.7, 0.7, 0.75))  # cabinet
-    return b
-
-
-def box_field(faces):
-    """A room with a light and a grid of open boxes (5 faces each) on the floor."""
-    b = SceneBuilder()
-    b.box((0, 0, 0), (20, 20, 4), rho=0.6, inward=True)
-    b.polygon([(9, 9, 3.99), (9, 11, 3.99), (11, 11, 3.99), (11, 9, 3.99)], rho=0.0, emission=10.0,
-              two_sided=False)
-    count = max(1, (faces - 7) // 5)
-    side = int(np.ceil(np.sqrt(count)))
-    pitch = 18.0 / side
-    made = 0
-    for i in range(side):
-        for j in range(side):
-            if made < count:
-                x, y = 1 + i * pitch, 1 + j * pitch
-                # The bottom touches the floor and is never seen: left out.
-                b.box((x, y, 0), (x + 0.5 * pitch, y + 0.5 * pitch, 0.5 * pitch), rho=0.5, skip=(0,))
-                made += 1
     return b
 
 

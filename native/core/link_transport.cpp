@@ -52,7 +52,7 @@ double distance_to_polygon(const dvec3& p, std::span<const dvec3> polygon) {
 
 }  // namespace
 
-SceneOccluders make_scene_occluders(const Scene& scene, VisibilityMode mode) {
+SceneOccluders make_scene_occluders(const Scene& scene) {
   std::vector<Triangle> triangles;
   std::vector<std::uint32_t> face;
   for (const Patch& p : scene.patches) {
@@ -64,7 +64,8 @@ SceneOccluders make_scene_occluders(const Scene& scene, VisibilityMode mode) {
     }
   }
   SceneOccluders occluders;
-  if (mode == VisibilityMode::Sampled) occluders.rays = std::make_unique<RayScene>(triangles, face);
+  // Sampled visibility and cluster links cast rays.
+  occluders.rays = std::make_unique<RayScene>(triangles, face);
   occluders.shafts = make_occluder_scene(std::move(triangles), std::move(face));
   return occluders;
 }
@@ -109,6 +110,10 @@ std::vector<Triangle>& gather_candidates(const OccluderScene& scene, const Shaft
   for (std::uint32_t t : culling.candidates) candidates.push_back(scene.triangles[t]);
   return candidates;
 }
+
+// Candidate occluders past which shadow rays go through Embree rather than
+// being tested one by one (the crossover measured near 35 candidates).
+constexpr std::size_t kRayCrossover = 32;
 
 FormFactorGradient unoccluded(const LinkEvaluator& evaluator, const dvec3& x, const dvec3& n,
                               std::span<const dvec3> emitter) {
@@ -213,9 +218,11 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo)
   const std::span<const dvec3> emitter_polygon = ends.emitter_polygon();
 
   auto start = Clock::now();
+  // Shadow rays need no list of occluders: past the crossover, stop looking.
+  const std::size_t limit = visibility == VisibilityMode::Sampled ? kRayCrossover : std::numeric_limits<std::size_t>::max();
   const ShaftCulling culling =
       cull_shaft(occluders.shafts, ends.receiver_polygon(), hierarchy.patch_of(receiver).face,
-                 emitter_polygon, hierarchy.patch_of(emitter).face);
+                 emitter_polygon, hierarchy.patch_of(emitter).face, limit);
   timings.visibility += seconds_since(start);
   if (culling.visibility == ShaftVisibility::hidden) return false;
 
@@ -249,10 +256,10 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo)
       // Rays per sample vary their seed with the sample, so neighbours do not
       // share the same stratification pattern.
       // Few candidates: test them directly in double precision; many: let
-      // Embree traverse the scene (the crossover measured near 35 candidates).
+      // Embree traverse the scene.
       ++timings.samples_occluded;
       const SampledVisibilityOptions options{rays, static_cast<std::uint64_t>(s)};
-      f = candidates.size() > 32 && occluders.rays
+      f = culling.truncated
               ? sampled_form_factor_gradient(x, ends.n, emitter_polygon, *occluders.rays, options,
                                              hierarchy.patch_of(receiver).face,
                                              hierarchy.patch_of(emitter).face)

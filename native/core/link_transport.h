@@ -57,10 +57,10 @@ struct LinkTimings {
 // input face so a link never shadows itself.
 struct SceneOccluders {
   OccluderScene shafts;
-  std::unique_ptr<RayScene> rays;  // only for sampled visibility
+  std::unique_ptr<RayScene> rays;  // sampled visibility, cluster links
 };
 
-SceneOccluders make_scene_occluders(const Scene& scene, VisibilityMode mode);
+SceneOccluders make_scene_occluders(const Scene& scene);
 
 // Form factors already computed at the corners of sibling receivers linked to
 // the same emitter. The four children of a split receiver share 9 of their 16

@@ -286,16 +286,21 @@ bool shaft_overlaps(const Shaft& shaft, const Triangle& t) {
 
 ShaftCulling cull_shaft(const OccluderScene& scene, std::span<const dvec3> receiver,
                         std::uint32_t receiver_face, std::span<const dvec3> emitter,
-                        std::uint32_t emitter_face) {
+                        std::uint32_t emitter_face, std::size_t limit) {
   ShaftCulling out;
   const Shaft shaft = make_shaft(receiver, emitter);
   if (shaft.flat) return out;  // coplanar elements exchange nothing
   traverse_scene_bvh(
-      scene.bvh, [&](const Aabb& box) { return !box_outside(shaft, box); },
+      scene.bvh, [&](const Aabb& box) { return !out.truncated && !box_outside(shaft, box); },
       [&](std::uint32_t t) {
         const std::uint32_t f = scene.face[t];
-        if (f == receiver_face || f == emitter_face) return;
-        if (shaft_overlaps(shaft, scene.triangles[t])) out.candidates.push_back(t);
+        if (out.truncated || f == receiver_face || f == emitter_face) return;
+        if (!shaft_overlaps(shaft, scene.triangles[t])) return;
+        if (out.candidates.size() == limit) {
+          out.truncated = true;
+          return;
+        }
+        out.candidates.push_back(t);
       });
   std::sort(out.candidates.begin(), out.candidates.end());
   out.visibility = classify(scene, out.candidates, receiver, emitter, shaft.tolerance);

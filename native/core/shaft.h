@@ -64,11 +64,16 @@ enum class ShaftVisibility { clear, partial, hidden };
 struct ShaftCulling {
   ShaftVisibility visibility = ShaftVisibility::clear;
   std::vector<std::uint32_t> candidates;  // triangle indices into the scene
+  bool truncated = false;  // more than the limit: `candidates` holds only some
 };
 
+// With a `limit`, stops once more candidates than that are found (for
+// shadow rays, which need no list): `hidden` is then still proved by the ones
+// found, never `clear`.
 ShaftCulling cull_shaft(const OccluderScene& scene, std::span<const dvec3> receiver,
                         std::uint32_t receiver_face, std::span<const dvec3> emitter,
-                        std::uint32_t emitter_face);
+                        std::uint32_t emitter_face,
+                        std::size_t limit = std::numeric_limits<std::size_t>::max());
 
 // The same without the BVH, every triangle tested: the reference for tests and
 // benchmarks.

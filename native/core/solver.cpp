@@ -1,5 +1,8 @@
 #include "core/solver.h"
 
+#include "core/cluster_links.h"
+#include "core/cluster_tree.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -35,6 +38,16 @@ ThresholdRange threshold_range(Oracle oracle) {
 
 enum class Split : std::uint8_t { None, Receiver, Emitter };
 
+// Far enough apart for a cluster link: the point-to-point kernel between the
+// clusters' centres errs by about (sum of radii / distance)^2 on what the link
+// carries, so finer quality asks for more distance.
+double cluster_separation(const SolveOptions& options) {
+  return options.cluster_separation > 0.0 ? options.cluster_separation : 2.0 + 8.0 * options.quality;
+}
+
+// Shadow rays that must all pass before two clusters share one link.
+constexpr int kClusterRays = 16;
+
 class Solver {
  public:
   Solver(const Scene& scene, const SolveOptions& options, const ProgressCallback& progress,
@@ -45,11 +58,12 @@ class Solver {
         cancel_(cancel),
         start_(Clock::now()),
         hierarchy_(scene),
-        occluders_(make_scene_occluders(scene, options.visibility)),
+        occluders_(make_scene_occluders(scene)),
         evaluator_{hierarchy_, occluders_, options.visibility, options.rays, options.oracle,
                    oracle_geometric_scale(options.oracle, scene.total_area)},
         reference_radiance_(scene.reference_radiance()),
-        min_area_(options.min_element_area * scene.total_area) {}
+        min_area_(options.min_element_area * scene.total_area),
+        clusters_(hierarchy_) {}
 
   SolveResult run();
 
@@ -69,6 +83,7 @@ class Solver {
   bool can_split(std::int32_t e) const { return hierarchy_.element(e).area / 4.0 >= min_area_; }
   bool near_field(const Link& link, bool receiver_end) const;
   void group_links();
+  void gather_far_light();
   double gather_push_pull();
   double iterate(double threshold, int max_iterations, double tolerance);
   void snapshot(double threshold);
@@ -89,6 +104,10 @@ class Solver {
   // Links grouped by receiver for the gather, and which links they describe.
   std::vector<std::uint32_t> offset_, order_;
   std::vector<Rgb> source_;  // radiance per element as the last gather read it
+  ClusterTree clusters_;
+  std::vector<ClusterLink> cluster_links_;
+  ClusterGather cluster_gather_;
+  std::vector<Rgb> far_light_;  // what each top-level element gathers through cluster links
   std::uint64_t links_version_ = 1, grouped_version_ = 0;
   SolveResult result_;  // the last complete pass
   bool budget_hit_ = false;
@@ -115,8 +134,10 @@ void Solver::report(const std::string& phase, double fraction) {
 // gather tables; links: the links and their receiver grouping.
 void Solver::track_memory() {
   stats_.element_bytes = hierarchy_.memory_bytes() + offset_.capacity() * sizeof(std::uint32_t) +
-                         source_.capacity() * sizeof(Rgb);
-  stats_.link_bytes = links_.capacity() * sizeof(Link) + order_.capacity() * sizeof(std::uint32_t);
+                         source_.capacity() * sizeof(Rgb) + clusters_.memory_bytes() +
+                         cluster_gather_.memory_bytes() + far_light_.capacity() * sizeof(Rgb);
+  stats_.link_bytes = links_.capacity() * sizeof(Link) + order_.capacity() * sizeof(std::uint32_t) +
+                      cluster_links_.capacity() * sizeof(ClusterLink);
   stats_.peak_bytes = std::max(stats_.peak_bytes, stats_.element_bytes + stats_.link_bytes);
 }
 
@@ -188,48 +209,34 @@ std::vector<Link> Solver::evaluate_links(std::vector<Link>&& candidates) {
   return std::move(candidates);
 }
 
-// Links between every pair of facing top-level patch sides that can exchange
-// light: the receiver reflects, the emitter emits or reflects. The facing test
-// is cheap and runs first; visibility only for the pairs that pass it.
+// Links between the top-level patch sides that can exchange light (the
+// receiver reflects, the emitter emits or reflects): clusters far apart that
+// face each other get one cluster link, pairs facing away are dropped whole,
+// before any visibility work; the remaining pairs of sides are evaluated as
+// ordinary links (cluster_links.h).
 void Solver::link_initially() {
   const auto start = Clock::now();
-  std::vector<std::int32_t> receivers, sources;
-  for (std::uint32_t p = 0; p < scene_.patches.size(); ++p) {
-    const Patch& patch = scene_.patches[p];
-    const bool reflects = luminance(patch.reflectance) > 0.0;
-    const bool emits = luminance(patch.emission) > 0.0;
-    for (int side = 0; side < 2; ++side) {
-      const std::int32_t root = hierarchy_.root(p, side);
-      if (root == kNone) continue;
-      if (reflects) receivers.push_back(root);
-      if (reflects || emits) sources.push_back(root);
-    }
-  }
-  // Receivers in blocks, so the candidate list stays small for large scenes.
-  const size_t block = 64;
-  for (size_t begin = 0; begin < receivers.size() && !cancelled(); begin += block) {
-    const size_t end = std::min(receivers.size(), begin + block);
-    std::vector<std::vector<Link>> per_receiver(end - begin);
-    tbb::parallel_for(tbb::blocked_range<size_t>(begin, end), [&](const auto& range) {
-      for (size_t i = range.begin(); i != range.end(); ++i) {
-        const Element& r = hierarchy_.element(receivers[i]);
-        for (std::int32_t q : sources) {
-          const Element& s = hierarchy_.element(q);
-          if (s.patch == r.patch) continue;
-          if (!elements_face_each_other(hierarchy_, r, s)) continue;
-          Link link;
-          link.receiver = receivers[i];
-          link.emitter = q;
-          per_receiver[i - begin].push_back(link);
-        }
-      }
-    });
-    std::vector<Link> candidates;
-    for (auto& list : per_receiver) candidates.insert(candidates.end(), list.begin(), list.end());
-    std::vector<Link> visible = evaluate_links(std::move(candidates));
+  InitialLinks initial = link_clusters(clusters_, hierarchy_, *occluders_.rays, cluster_separation(options_),
+                                       kClusterRays, [this] { return cancelled(); });
+  stats_.seconds_clustering = std::chrono::duration<double>(Clock::now() - start).count();
+  // In blocks, so cancellation and progress stay prompt for large scenes.
+  const size_t block = 65536;
+  std::vector<Link>& candidates = initial.elements;
+  for (size_t begin = 0; begin < candidates.size() && !cancelled(); begin += block) {
+    const size_t end = std::min(candidates.size(), begin + block);
+    std::vector<Link> visible = evaluate_links(std::vector<Link>(candidates.begin() + static_cast<std::ptrdiff_t>(begin),
+                                                                 candidates.begin() + static_cast<std::ptrdiff_t>(end)));
     links_.insert(links_.end(), visible.begin(), visible.end());
-    report("linking", 0.1 * static_cast<double>(end) / static_cast<double>(receivers.size()));
+    report("linking", 0.1 * static_cast<double>(end) / static_cast<double>(candidates.size()));
   }
+  candidates = {};
+  cluster_links_ = std::move(initial.clusters);
+  for (const ClusterLink& l : cluster_links_) {
+    const ClusterNode& node = clusters_.node(l.receiver);
+    for (std::uint32_t i = node.first; i < node.first + node.count; ++i)
+      hierarchy_.element(clusters_.sides()[i]).has_links = 1;
+  }
+  cluster_links_.shrink_to_fit();
   for (const Link& l : links_) hierarchy_.element(l.receiver).has_links = 1;
   links_.shrink_to_fit();
   hierarchy_.shrink_to_fit();
@@ -449,19 +456,30 @@ Rgb push_pull_element(Hierarchy& h, std::int32_t index, const std::array<Rgb, kM
   return radiance;
 }
 
-double push_pull_all(Hierarchy& h, const LinkGather& gather,
+// `far_light`: what each top-level element gathers through cluster links,
+// uniform over it (or empty).
+double push_pull_all(Hierarchy& h, const LinkGather& gather, const std::vector<Rgb>& far_light,
                      std::vector<std::array<Rgb, kMaxSamples>>* leaf_out) {
   const size_t roots = h.root_count();
   std::vector<Change> changes(roots);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, roots), [&](const auto& range) {
     for (size_t r = range.begin(); r != range.end(); ++r) {
       const std::int32_t root = h.root(static_cast<std::uint32_t>(r / 2), static_cast<int>(r % 2));
-      if (root != kNone) push_pull_element(h, root, {}, gather, changes[r], leaf_out);
+      if (root == kNone) continue;
+      std::array<Rgb, kMaxSamples> down{};
+      if (!far_light.empty()) down.fill(far_light[static_cast<size_t>(root)]);
+      push_pull_element(h, root, down, gather, changes[r], leaf_out);
     }
   });
   Change sum;
   for (const Change& c : changes) sum.delta += c.delta, sum.total += c.total;
   return sum.total > 0.0 ? sum.delta / sum.total : 0.0;
+}
+
+void Solver::gather_far_light() {
+  if (cluster_links_.empty()) return;
+  far_light_.resize(static_cast<size_t>(scene_.patches.size()) * 2);  // top-level elements come first
+  cluster_gather_(clusters_, cluster_links_, hierarchy_, source_, far_light_);
 }
 
 // One Jacobi iteration: the links read the radiances as they are now.
@@ -472,7 +490,8 @@ double Solver::gather_push_pull() {
   tbb::parallel_for(tbb::blocked_range<size_t>(0, elements.size()), [&](const auto& range) {
     for (size_t e = range.begin(); e != range.end(); ++e) source_[e] = elements[e].radiance;
   });
-  return push_pull_all(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, nullptr);
+  gather_far_light();
+  return push_pull_all(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_, nullptr);
 }
 
 
@@ -511,7 +530,8 @@ void Solver::snapshot(double threshold) {
   std::vector<std::array<Rgb, kMaxSamples>> leaf(hierarchy_.elements().size());
   source_.resize(hierarchy_.elements().size(), Rgb(0.0));
   group_links();
-  push_pull_all(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, &leaf);
+  gather_far_light();
+  push_pull_all(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_, &leaf);
   result_.mesh = make_output_mesh(hierarchy_, leaf);
   stats_.threshold = threshold;
 }
@@ -570,6 +590,7 @@ SolveResult Solver::run() {
   stats_.leaves = static_cast<size_t>(std::count_if(elements.begin(), elements.end(),
                                                     [](const Element& e) { return e.is_leaf(); }));
   stats_.links = links_.size();
+  stats_.cluster_links = cluster_links_.size();
   stats_.skipped_faces = scene_.skipped.size();
   track_memory();
   stats_.seconds = elapsed();

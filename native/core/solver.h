@@ -42,6 +42,11 @@ struct SolveOptions {
   // 5 times more links).
   enum class LeafLinks : std::uint8_t { None, Near, All };
   LeafLinks leaf_links = LeafLinks::Near;
+  // Clusters of patch sides whose centres are further apart than this many
+  // times the sum of their radii exchange light through one cluster link
+  // (cluster_links.h); infinity: every pair of patch sides is linked;
+  // 0: from the quality, 2 at 0 to 10 at 1.
+  double cluster_separation = 0.0;
   double tolerance = 1e-6;  // relative change of radiance that counts as converged
   int max_iterations = 5000;
 };
@@ -61,6 +66,7 @@ struct SolveStats {
   std::size_t elements = 0;
   std::size_t leaves = 0;
   std::size_t links = 0;
+  std::size_t cluster_links = 0;
   int passes = 0;
   int iterations = 0;
   double residual = 0.0;     // relative change of the last iteration
@@ -70,6 +76,7 @@ struct SolveStats {
   std::string stopped_by;    // "quality", "max_elements", "time_budget", "cancel"
   double seconds = 0.0;
   double seconds_linking = 0.0;
+  double seconds_clustering = 0.0;  // of linking: the walk over cluster pairs, with its rays
   LinkTimings link_cpu;      // CPU seconds over all threads
   double seconds_gather = 0.0;  // gather and push/pull, wall clock
   std::size_t element_bytes = 0;

@@ -88,6 +88,7 @@ py::dict stats_dict(const SolveStats& s) {
   d["elements"] = s.elements;
   d["leaves"] = s.leaves;
   d["links"] = s.links;
+  d["cluster_links"] = s.cluster_links;
   d["passes"] = s.passes;
   d["iterations"] = s.iterations;
   d["residual"] = s.residual;
@@ -97,6 +98,7 @@ py::dict stats_dict(const SolveStats& s) {
   d["stopped_by"] = s.stopped_by;
   d["seconds"] = s.seconds;
   d["seconds_linking"] = s.seconds_linking;
+  d["seconds_clustering"] = s.seconds_clustering;
   d["seconds_gather"] = s.seconds_gather;
   d["cpu_visibility"] = s.link_cpu.visibility;
   d["cpu_form_factors"] = s.link_cpu.form_factors;
@@ -150,7 +152,8 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
                   std::optional<std::int64_t> max_elements, std::optional<double> time_budget,
                   const std::string& visibility, int rays, std::optional<int> bounces,
                   std::optional<int> threads, const py::object& progress,
-                  const py::object& cancel, double min_element_area, const std::string& leaf_links) {
+                  const py::object& cancel, double min_element_area, const std::string& leaf_links,
+                  std::optional<double> cluster_separation) {
   SolveOptions options;
   options.oracle = read_oracle(oracle);
   options.quality = quality;
@@ -164,6 +167,11 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
   options.bounces = bounces;
   options.threads = threads;
   options.min_element_area = min_element_area;
+  if (cluster_separation) {
+    if (!(*cluster_separation > 1.0))
+      throw std::invalid_argument("cluster_separation must be greater than 1 (or inf: no cluster links)");
+    options.cluster_separation = *cluster_separation;
+  }
   if (leaf_links == "none") {
     options.leaf_links = SolveOptions::LeafLinks::None;
   } else if (leaf_links == "near") {
@@ -263,11 +271,14 @@ void bind_solver(py::module_& m) {
         py::arg("bounces") = py::none(), py::arg("threads") = py::none(),
         py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
         py::arg("min_element_area") = 1e-5, py::arg("leaf_links") = "near",
+        py::arg("cluster_separation") = py::none(),
         "Hierarchical radiosity. oracle: 'standard' | 'perceptual' | 'gradient'; quality in\n"
         "[0, 1] (0: no refinement); max_elements, time_budget (s): budgets; visibility:\n"
         "'exact' | 'sampled' (rays per sample); bounces: fixed iteration count instead of\n"
         "convergence; threads; progress(dict) callback; cancel: CancelToken;\n"
-        "leaf_links: 'near' | 'all' | 'none', which links follow a split end down ('all': energy to 1e-3).");
+        "leaf_links: 'near' | 'all' | 'none', which links follow a split end down ('all': energy to 1e-3);\n"
+        "cluster_separation: clusters of faces this many times their radii apart share one link\n"
+        "(default from quality, 2 to 10; inf: none).");
   m.def("quality_threshold", [](const std::string& oracle, double quality) {
     return quality_threshold(read_oracle(oracle), quality);
   }, py::arg("oracle"), py::arg("quality"), "The oracle's refinement threshold at a quality level.");

@@ -62,3 +62,24 @@ def room_with_blocker(light=5.0):
                            rho=0.0, emission=light, two_sided=False)
     plate = b.polygon([(1.4, 1.4, 1.0), (2.6, 1.4, 1.0), (2.6, 2.6, 1.0), (1.4, 2.6, 1.0)], rho=0.5)
     return b, dict(room=room, light=light_face, blocker=[plate])
+
+
+def box_field(faces):
+    """A 20 x 20 x 4 room with a light and a grid of open boxes (5 two-sided
+    faces each) on the floor: about `faces` input faces, for scaling runs."""
+    b = SceneBuilder()
+    b.box((0, 0, 0), (20, 20, 4), rho=0.6, inward=True)
+    b.polygon([(9, 9, 3.99), (9, 11, 3.99), (11, 11, 3.99), (11, 9, 3.99)], rho=0.0, emission=10.0,
+              two_sided=False)
+    count = max(1, (faces - 7) // 5)
+    side = int(np.ceil(np.sqrt(count)))
+    pitch = 18.0 / side
+    made = 0
+    for i in range(side):
+        for j in range(side):
+            if made < count:
+                x, y = 1 + i * pitch, 1 + j * pitch
+                # The bottom touches the floor and is never seen: left out.
+                b.box((x, y, 0), (x + 0.5 * pitch, y + 0.5 * pitch, 0.5 * pitch), rho=0.5, skip=(0,))
+                made += 1
+    return b

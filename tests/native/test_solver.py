@@ -15,7 +15,7 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import _radiosity as rad  # noqa: E402
-from synthetic_scenes import SceneBuilder, room_with_blocker  # noqa: E402
+from synthetic_scenes import SceneBuilder, box_field, room_with_blocker  # noqa: E402
 
 ORACLES = ("standard", "perceptual", "gradient")
 
@@ -183,6 +183,36 @@ class EmitterSides(unittest.TestCase):
         self.assertEqual(set(result.source_side[polygons_of_lamp].tolist()), {0, 1})
         vertices = np.unique(np.concatenate([poly for poly, keep in zip(polygons(result), polygons_of_lamp) if keep]))
         np.testing.assert_allclose(result.radiance[vertices], np.tile([5, 4, 3], (len(vertices), 1)), rtol=1e-6)
+
+
+class Clustering(unittest.TestCase):
+    """Far clusters of faces that face each other share one link (cluster_links.h)."""
+
+    def test_cluster_links_replace_pairs_and_agree_with_them(self):
+        b = box_field(300)
+        clustered = rad.solve(b.scene(rad), oracle="standard", quality=0.0, cluster_separation=2.0)
+        pairs = rad.solve(b.scene(rad), oracle="standard", quality=0.0, cluster_separation=float("inf"))
+        self.assertGreater(clustered.stats["cluster_links"], 100)
+        self.assertEqual(pairs.stats["cluster_links"], 0)
+        self.assertLess(clustered.stats["links"], 0.8 * pairs.stats["links"])
+        # Unrefined, both give the same mesh; the radiance agrees closely.
+        np.testing.assert_array_equal(clustered.face_vertices, pairs.face_vertices)
+        self.assertLess(np.abs(clustered.radiance - pairs.radiance).mean() / pairs.radiance.mean(), 5e-3)
+        np.testing.assert_allclose(clustered.radiance, pairs.radiance, rtol=0.05, atol=0.02 * pairs.radiance.max())
+
+    def test_same_result_for_one_and_two_threads(self):
+        b = box_field(300)
+        one = rad.solve(b.scene(rad), oracle="standard", quality=0.2, cluster_separation=2.0, threads=1)
+        two = rad.solve(b.scene(rad), oracle="standard", quality=0.2, cluster_separation=2.0, threads=2)
+        self.assertGreater(one.stats["cluster_links"], 0)
+        self.assertEqual(one.stats["cluster_links"], two.stats["cluster_links"])
+        np.testing.assert_array_equal(one.radiance, two.radiance)
+
+    def test_separation_must_exceed_one(self):
+        b, _ = room_with_blocker()
+        for bad in (1.0, 0.5, -2.0, float("nan")):
+            with self.assertRaisesRegex(ValueError, "cluster_separation"):
+                rad.solve(b.scene(rad), cluster_separation=bad)
 
 
 class TwoFacingSquares(unittest.TestCase):

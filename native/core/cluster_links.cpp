@@ -1,0 +1,229 @@
+#include "core/cluster_links.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <numbers>
+
+namespace radiosity {
+namespace {
+
+// Does every side of `node` face direction `w` (normals within 90 degrees),
+// for every direction within `cone` of w? And does none?
+bool all_facing(const ClusterNode& node, const dvec3& w, double cone) {
+  const double angle = std::acos(std::clamp(glm::dot(node.axis, w), -1.0, 1.0));
+  return angle + node.spread + cone < 0.5 * std::numbers::pi - 1e-6;
+}
+bool none_facing(const ClusterNode& node, const dvec3& w, double cone) {
+  const double angle = std::acos(std::clamp(glm::dot(node.axis, w), -1.0, 1.0));
+  return angle - node.spread - cone > 0.5 * std::numbers::pi + 1e-6;
+}
+
+// SplitMix64: a small, fast, seedable generator.
+struct Random {
+  std::uint64_t state;
+  std::uint64_t next() {
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  }
+  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
+};
+
+// A point uniformly distributed over the node's sides (area-weighted).
+dvec3 random_point(const ClusterTree& tree, const Hierarchy& hierarchy, const ClusterNode& node,
+                   Random& random, std::uint32_t& face) {
+  const auto& prefix = tree.area_prefix();
+  const double target = prefix[node.first] + random.uniform() * (prefix[node.first + node.count] - prefix[node.first]);
+  const auto it = std::upper_bound(prefix.begin() + node.first + 1, prefix.begin() + node.first + node.count, target);
+  const auto index = static_cast<size_t>(it - prefix.begin()) - 1;
+  const Element& e = hierarchy.element(tree.sides()[index]);
+  face = hierarchy.patch_of(e).face;
+  dvec3 c[4];
+  const int n = hierarchy.corners(e, c);
+  dvec3 a = c[0], b = c[1], t = c[2];
+  if (n == 4) {
+    const double first = glm::length(glm::cross(c[1] - c[0], c[2] - c[0]));
+    const double second = glm::length(glm::cross(c[2] - c[0], c[3] - c[0]));
+    if (random.uniform() * (first + second) >= first) b = c[2], t = c[3];
+  }
+  const double s = std::sqrt(random.uniform()), r = random.uniform();
+  return (1 - s) * a + s * (1 - r) * b + s * r * t;
+}
+
+// What the walk does with one pair of clusters.
+struct PairOutcome {
+  enum Kind : std::uint8_t { Drop, ClusterPair, ElementPair, SplitReceiver, SplitEmitter, SplitBoth } kind = Drop;
+  ClusterLink link;  // ClusterPair: the link; ElementPair: its receiver and emitter elements
+};
+
+// Of `rays` shadow rays between random points of the two clusters' sides, how
+// many pass. Seeded by the pair: the answer does not depend on threads.
+int passing_rays(const ClusterTree& tree, const Hierarchy& hierarchy, const RayScene& scene,
+                 std::int32_t receiver, std::int32_t emitter, int rays) {
+  Random random{(static_cast<std::uint64_t>(static_cast<std::uint32_t>(receiver)) << 32) |
+                static_cast<std::uint32_t>(emitter)};
+  int passed = 0;
+  for (int k = 0; k < rays; ++k) {
+    std::uint32_t from_face = 0, to_face = 0;
+    const dvec3 from = random_point(tree, hierarchy, tree.node(emitter), random, from_face);
+    const dvec3 to = random_point(tree, hierarchy, tree.node(receiver), random, to_face);
+    passed += scene.occluded(from, to, from_face, to_face) ? 0 : 1;
+  }
+  return passed;
+}
+
+PairOutcome classify(const ClusterTree& tree, const Hierarchy& hierarchy, const RayScene& scene,
+                     double separation, int rays, std::int32_t x, std::int32_t y) {
+  PairOutcome out;
+  const ClusterNode& rx = tree.node(x);
+  const ClusterNode& ry = tree.node(y);
+  if (!rx.reflects || !ry.sends) return out;
+  const auto split = [&](PairOutcome::Kind kind) {
+    out.kind = kind;
+    return out;
+  };
+  if (x == y) return rx.is_leaf() ? out : split(PairOutcome::SplitBoth);
+  const bool both_leaves = rx.is_leaf() && ry.is_leaf();
+  const dvec3 between = rx.centre - ry.centre;
+  const double d = glm::length(between);
+  if (d > 0.0) {
+    const dvec3 w = between / d;
+    // Directions between any two points of the two bounds.
+    const double cone = d > rx.radius + ry.radius ? std::asin((rx.radius + ry.radius) / d) : 0.5 * std::numbers::pi;
+    if (none_facing(ry, w, cone) || none_facing(rx, -w, cone)) return out;
+    // Facing is judged along the centres' direction only: where the clusters
+    // are far apart, a side seen at a grazing angle from part of the other
+    // carries little light either way.
+    if (!both_leaves && d > separation * (rx.radius + ry.radius) && all_facing(ry, w, 0.0) &&
+        all_facing(rx, -w, 0.0)) {
+      // A cluster link ends on one side: the distance to the emitter cluster
+      // is then that side's own (a receiving cluster would give the light of
+      // its centre to every side, off by 2 r / d).
+      if (!rx.is_leaf()) return split(PairOutcome::SplitReceiver);
+      const int passed = passing_rays(tree, hierarchy, scene, x, y, rays);
+      if (passed == 0) return out;
+      out.kind = PairOutcome::ClusterPair;
+      out.link.receiver = x;
+      out.link.emitter = y;
+      out.link.direction = {static_cast<float>(w.x), static_cast<float>(w.y), static_cast<float>(w.z)};
+      out.link.coupling = static_cast<float>(passed) / static_cast<float>(rays) / static_cast<float>(std::numbers::pi * d * d);
+      return out;
+    }
+  }
+  if (both_leaves) {
+    const std::int32_t p = tree.sides()[rx.first], q = tree.sides()[ry.first];
+    const Element& receiver = hierarchy.element(p);
+    const Element& emitter = hierarchy.element(q);
+    if (receiver.patch == emitter.patch || !elements_face_each_other(hierarchy, receiver, emitter)) return out;
+    out.kind = PairOutcome::ElementPair;
+    out.link.receiver = p;
+    out.link.emitter = q;
+    return out;
+  }
+  // Split the larger cluster.
+  return split(!rx.is_leaf() && (ry.is_leaf() || rx.radius >= ry.radius) ? PairOutcome::SplitReceiver
+                                                                          : PairOutcome::SplitEmitter);
+}
+
+}  // namespace
+
+InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy, const RayScene& scene,
+                           double separation, int rays, const std::function<bool()>& cancelled) {
+  InitialLinks links;
+  if (tree.root() == kNone) return links;
+  // Breadth first, one level of pairs at a time in parallel; outcomes are
+  // collected in pair order, so the links do not depend on the thread count.
+  std::vector<std::pair<std::int32_t, std::int32_t>> frontier{{tree.root(), tree.root()}};
+  std::vector<std::pair<std::int32_t, std::int32_t>> next;
+  std::vector<PairOutcome> outcomes;
+  while (!frontier.empty() && !(cancelled && cancelled())) {
+    outcomes.resize(frontier.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, frontier.size()), [&](const auto& range) {
+      for (size_t i = range.begin(); i != range.end(); ++i)
+        outcomes[i] = classify(tree, hierarchy, scene, separation, rays, frontier[i].first, frontier[i].second);
+    });
+    next.clear();
+    for (size_t i = 0; i < frontier.size(); ++i) {
+      const PairOutcome& o = outcomes[i];
+      const auto [x, y] = frontier[i];
+      switch (o.kind) {
+        case PairOutcome::Drop: break;
+        case PairOutcome::ClusterPair: links.clusters.push_back(o.link); break;
+        case PairOutcome::ElementPair: {
+          Link link;
+          link.receiver = o.link.receiver;
+          link.emitter = o.link.emitter;
+          links.elements.push_back(link);
+          break;
+        }
+        case PairOutcome::SplitReceiver:
+          for (std::int32_t c : tree.node(x).child) next.emplace_back(c, y);
+          break;
+        case PairOutcome::SplitEmitter:
+          for (std::int32_t c : tree.node(y).child) next.emplace_back(x, c);
+          break;
+        case PairOutcome::SplitBoth:
+          for (std::int32_t a : tree.node(x).child)
+            for (std::int32_t b : tree.node(x).child) next.emplace_back(a, b);
+          break;
+      }
+    }
+    std::swap(frontier, next);
+  }
+  return links;
+}
+
+void ClusterGather::operator()(const ClusterTree& tree, const std::vector<ClusterLink>& links,
+                               const Hierarchy& hierarchy, const std::vector<Rgb>& radiance,
+                               std::vector<Rgb>& gathered) {
+  const auto& nodes = tree.nodes();
+  power_.assign(nodes.size(), ChannelVectors{});
+  received_.assign(nodes.size(), ChannelVectors{});
+  // Power vectors, leaves up (children come after their parent).
+  for (size_t i = nodes.size(); i-- > 0;) {
+    const ClusterNode& node = nodes[i];
+    ChannelVectors& p = power_[i];
+    if (node.is_leaf()) {
+      const std::int32_t side = tree.sides()[node.first];
+      const Element& e = hierarchy.element(side);
+      const Rgb& l = radiance[static_cast<size_t>(side)];
+      const dvec3 n = e.area * hierarchy.normal(e);
+      p = {l.x * n, l.y * n, l.z * n};
+    } else {
+      for (int c = 0; c < 3; ++c)
+        p[static_cast<size_t>(c)] = power_[static_cast<size_t>(node.child[0])][static_cast<size_t>(c)] +
+                                    power_[static_cast<size_t>(node.child[1])][static_cast<size_t>(c)];
+    }
+  }
+  // Each link: the emitter's intensity towards the receiver, as a vector the
+  // receiver's sides take their cosine of.
+  for (const ClusterLink& link : links) {
+    const dvec3 w(link.direction[0], link.direction[1], link.direction[2]);
+    const ChannelVectors& p = power_[static_cast<size_t>(link.emitter)];
+    ChannelVectors& r = received_[static_cast<size_t>(link.receiver)];
+    for (int c = 0; c < 3; ++c) {
+      const double intensity = std::max(0.0, glm::dot(p[static_cast<size_t>(c)], w));
+      r[static_cast<size_t>(c)] -= static_cast<double>(link.coupling) * intensity * w;
+    }
+  }
+  // Down to the sides, through every enclosing cluster.
+  gathered.assign(gathered.size(), Rgb(0.0));
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    const ClusterNode& node = nodes[i];
+    const ChannelVectors& r = received_[i];
+    if (node.is_leaf()) {
+      const std::int32_t side = tree.sides()[node.first];
+      const dvec3 n = hierarchy.normal(hierarchy.element(side));
+      gathered[static_cast<size_t>(side)] =
+          glm::max(Rgb(glm::dot(n, r[0]), glm::dot(n, r[1]), glm::dot(n, r[2])), Rgb(0.0));
+      continue;
+    }
+    for (std::int32_t child : node.child)
+      for (int c = 0; c < 3; ++c) received_[static_cast<size_t>(child)][static_cast<size_t>(c)] += r[static_cast<size_t>(c)];
+  }
+}
+
+}  // namespace radiosity
