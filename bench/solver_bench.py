@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """Solver benchmark: elements, links, time and memory per oracle at two quality
 levels on the bundled scenes (exported from Blender as the add-on does) and on
-array-built scenes, and initial linking on generated many-face scenes.
+array-built scenes, and generated many-face scenes (a room of open boxes) at
+the coarsest quality, where clustering carries the initial linking.
 
     /usr/bin/python3 bench/solver_bench.py [--build build] [--blender blender]
-                                           [--faces 250 500 1000] [--quick]
+                                           [--faces 1000 2500 5000 10000] [--quick]
 
 Writes CSV to <build>/bench/solver.csv and a Markdown table to
 <build>/bench/solver.md. Times are the median of --repeats runs (the machine is
@@ -80,19 +81,21 @@ def measure(rad, builder, oracle, quality, repeats, **options):
         times.append(time.perf_counter() - start)
         cpu.append(time.process_time() - start_cpu)
     s = result.stats
-    return dict(oracle=oracle, quality=quality, seconds=round(statistics.median(times), 3),
+    return dict(oracle=oracle, quality=quality, visibility=options.get("visibility", "exact"),
+                seconds=round(statistics.median(times), 3),
                 cpu_seconds=round(statistics.median(cpu), 3), leaves=s["leaves"], elements=s["elements"],
-                links=s["links"], iterations=s["iterations"], passes=s["passes"],
+                links=s["links"], cluster_links=s["cluster_links"], iterations=s["iterations"], passes=s["passes"],
                 bytes_per_element=round(s["bytes_per_element"], 1), bytes_per_link=round(s["bytes_per_link"], 1),
                 peak_mb=round(s["peak_bytes"] / 2**20, 1), rss_mb=round(s["peak_rss_bytes"] / 2**20, 1),
-                linking_s=round(s["seconds_linking"], 3), cpu_visibility=round(s["cpu_visibility"], 2),
+                linking_s=round(s["seconds_linking"], 3), clustering_s=round(s["seconds_clustering"], 3),
+                cpu_visibility=round(s["cpu_visibility"], 2),
                 cpu_form_factors=round(s["cpu_form_factors"], 2), gather_s=round(s["seconds_gather"], 2),
                 samples_occluded=s["samples_occluded"], samples_shared=s["samples_shared"])
 
 
 def markdown(rows):
-    keys = ("scene", "faces", "oracle", "quality", "seconds", "cpu_seconds", "leaves", "elements", "links",
-            "bytes_per_element", "bytes_per_link", "peak_mb", "linking_s")
+    keys = ("scene", "faces", "oracle", "quality", "visibility", "seconds", "cpu_seconds", "leaves", "elements",
+            "links", "cluster_links", "bytes_per_element", "bytes_per_link", "peak_mb", "rss_mb", "linking_s")
     lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
     lines += ["| " + " | ".join(str(r[k]) for k in keys) + " |" for r in rows]
     return "\n".join(lines) + "\n"
@@ -102,8 +105,10 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--build", default="build")
     parser.add_argument("--blender", default="blender")
-    parser.add_argument("--faces", type=int, nargs="+", default=[250, 500, 1000],
-                        help="faces of the generated scenes (initial linking grows about as faces^2.7)")
+    parser.add_argument("--faces", type=int, nargs="+", default=[1000, 2500, 5000, 10000],
+                        help="faces of the generated scenes, solved at quality 0 with sampled visibility")
+    parser.add_argument("--exact-faces", type=int, default=2500,
+                        help="also solve the generated scenes up to this size with exact visibility")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--quick", action="store_true", help="fewer points, smaller generated scene")
     args = parser.parse_args()
@@ -112,8 +117,8 @@ def main():
 
     rows = []
 
-    def run(name, builder, oracle, quality, repeats):
-        row = dict(scene=name, faces=len(builder.faces), **measure(rad, builder, oracle, quality, repeats))
+    def run(name, builder, oracle, quality, repeats, **options):
+        row = dict(scene=name, faces=len(builder.faces), **measure(rad, builder, oracle, quality, repeats, **options))
         rows.append(row)
         print(row, flush=True)
 
@@ -127,7 +132,9 @@ def main():
                 run(name, builder, oracle, quality, args.repeats)
     for faces in ([250] if args.quick else args.faces):
         field = box_field(faces)
-        run("box_field_%d" % len(field.faces), field, "standard", 0.0, 1)
+        run("box_field", field, "standard", 0.0, 1, visibility="sampled")
+        if faces <= args.exact_faces:
+            run("box_field", field, "standard", 0.0, 1, visibility="exact")
 
     out = ROOT / args.build / "bench"
     out.mkdir(parents=True, exist_ok=True)

@@ -199,6 +199,8 @@ class Clustering(unittest.TestCase):
         np.testing.assert_array_equal(clustered.face_vertices, pairs.face_vertices)
         self.assertLess(np.abs(clustered.radiance - pairs.radiance).mean() / pairs.radiance.mean(), 5e-3)
         np.testing.assert_allclose(clustered.radiance, pairs.radiance, rtol=0.05, atol=0.02 * pairs.radiance.max())
+        # The room is closed: what the cluster links carry is absorbed like the rest.
+        np.testing.assert_allclose(absorbed_power(b, clustered), absorbed_power(b, pairs), rtol=3e-3)
 
     def test_same_result_for_one_and_two_threads(self):
         b = box_field(300)
