@@ -130,48 +130,89 @@ PairOutcome classify(const ClusterTree& tree, const Hierarchy& hierarchy, const 
 
 }  // namespace
 
+namespace {
+
+void append(InitialLinks& to, const PairOutcome& o) {
+  if (o.kind == PairOutcome::ClusterPair) {
+    to.clusters.push_back(o.link);
+  } else if (o.kind == PairOutcome::ElementPair) {
+    Link link;
+    link.receiver = o.link.receiver;
+    link.emitter = o.link.emitter;
+    to.elements.push_back(link);
+  }
+}
+
+// The pairs a split makes, in a fixed order.
+int children(const ClusterTree& tree, const PairOutcome& o, std::int32_t x, std::int32_t y,
+             std::pair<std::int32_t, std::int32_t>* out) {
+  int n = 0;
+  switch (o.kind) {
+    case PairOutcome::SplitReceiver:
+      for (std::int32_t c : tree.node(x).child) out[n++] = {c, y};
+      break;
+    case PairOutcome::SplitEmitter:
+      for (std::int32_t c : tree.node(y).child) out[n++] = {x, c};
+      break;
+    case PairOutcome::SplitBoth:
+      for (std::int32_t a : tree.node(x).child)
+        for (std::int32_t b : tree.node(x).child) out[n++] = {a, b};
+      break;
+    default: break;
+  }
+  return n;
+}
+
+}  // namespace
+
 InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy, const RayScene& scene,
                            double separation, int rays, const std::function<bool()>& cancelled) {
   InitialLinks links;
   if (tree.root() == kNone) return links;
-  // Breadth first, one level of pairs at a time in parallel; outcomes are
-  // collected in pair order, so the links do not depend on the thread count.
-  std::vector<std::pair<std::int32_t, std::int32_t>> frontier{{tree.root(), tree.root()}};
-  std::vector<std::pair<std::int32_t, std::int32_t>> next;
-  std::vector<PairOutcome> outcomes;
-  while (!frontier.empty() && !(cancelled && cancelled())) {
-    outcomes.resize(frontier.size());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, frontier.size()), [&](const auto& range) {
-      for (size_t i = range.begin(); i != range.end(); ++i)
-        outcomes[i] = classify(tree, hierarchy, scene, separation, rays, frontier[i].first, frontier[i].second);
-    });
-    next.clear();
-    for (size_t i = 0; i < frontier.size(); ++i) {
-      const PairOutcome& o = outcomes[i];
-      const auto [x, y] = frontier[i];
-      switch (o.kind) {
-        case PairOutcome::Drop: break;
-        case PairOutcome::ClusterPair: links.clusters.push_back(o.link); break;
-        case PairOutcome::ElementPair: {
-          Link link;
-          link.receiver = o.link.receiver;
-          link.emitter = o.link.emitter;
-          links.elements.push_back(link);
-          break;
-        }
-        case PairOutcome::SplitReceiver:
-          for (std::int32_t c : tree.node(x).child) next.emplace_back(c, y);
-          break;
-        case PairOutcome::SplitEmitter:
-          for (std::int32_t c : tree.node(y).child) next.emplace_back(x, c);
-          break;
-        case PairOutcome::SplitBoth:
-          for (std::int32_t a : tree.node(x).child)
-            for (std::int32_t b : tree.node(x).child) next.emplace_back(a, b);
-          break;
-      }
+  using Pair = std::pair<std::int32_t, std::int32_t>;
+  const auto classify_pair = [&](const Pair& p) {
+    return classify(tree, hierarchy, scene, separation, rays, p.first, p.second);
+  };
+  // Breadth first until there are enough pairs to share between threads, then
+  // each pair's subtree depth first (memory stays that of one path per
+  // thread), each into its own lists, joined in pair order: the links do not
+  // depend on the thread count.
+  std::vector<Pair> frontier{{tree.root(), tree.root()}};
+  while (!frontier.empty() && frontier.size() < 4096) {
+    std::vector<Pair> next;
+    for (const Pair& p : frontier) {
+      const PairOutcome o = classify_pair(p);
+      append(links, o);
+      Pair made[4];
+      const int n = children(tree, o, p.first, p.second, made);
+      next.insert(next.end(), made, made + n);
     }
-    std::swap(frontier, next);
+    frontier = std::move(next);
+  }
+  std::vector<InitialLinks> found(frontier.size());
+  const size_t chunk = 256;  // pairs between cancellation checks
+  for (size_t begin = 0; begin < frontier.size() && !(cancelled && cancelled()); begin += chunk) {
+    const size_t end = std::min(frontier.size(), begin + chunk);
+    tbb::parallel_for(tbb::blocked_range<size_t>(begin, end, 1), [&](const auto& range) {
+      std::vector<Pair> stack;
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        stack.assign(1, frontier[i]);
+        while (!stack.empty()) {
+          const Pair p = stack.back();
+          stack.pop_back();
+          const PairOutcome o = classify_pair(p);
+          append(found[i], o);
+          Pair made[4];
+          const int n = children(tree, o, p.first, p.second, made);
+          for (int k = n; k-- > 0;) stack.push_back(made[k]);  // first child on top: visited first
+        }
+      }
+    });
+  }
+  for (InitialLinks& part : found) {
+    links.clusters.insert(links.clusters.end(), part.clusters.begin(), part.clusters.end());
+    links.elements.insert(links.elements.end(), part.elements.begin(), part.elements.end());
+    part = {};
   }
   return links;
 }
@@ -181,7 +222,6 @@ void ClusterGather::operator()(const ClusterTree& tree, const std::vector<Cluste
                                std::vector<Rgb>& gathered) {
   const auto& nodes = tree.nodes();
   power_.assign(nodes.size(), ChannelVectors{});
-  received_.assign(nodes.size(), ChannelVectors{});
   // Power vectors, leaves up (children come after their parent).
   for (size_t i = nodes.size(); i-- > 0;) {
     const ClusterNode& node = nodes[i];
@@ -198,31 +238,17 @@ void ClusterGather::operator()(const ClusterTree& tree, const std::vector<Cluste
                                     power_[static_cast<size_t>(node.child[1])][static_cast<size_t>(c)];
     }
   }
-  // Each link: the emitter's intensity towards the receiver, as a vector the
-  // receiver's sides take their cosine of.
+  // Each link: the emitter's intensity towards the receiving side, taken
+  // through that side's own normal.
+  gathered.assign(gathered.size(), Rgb(0.0));
   for (const ClusterLink& link : links) {
     const dvec3 w(link.direction[0], link.direction[1], link.direction[2]);
     const ChannelVectors& p = power_[static_cast<size_t>(link.emitter)];
-    ChannelVectors& r = received_[static_cast<size_t>(link.receiver)];
-    for (int c = 0; c < 3; ++c) {
-      const double intensity = std::max(0.0, glm::dot(p[static_cast<size_t>(c)], w));
-      r[static_cast<size_t>(c)] -= static_cast<double>(link.coupling) * intensity * w;
-    }
-  }
-  // Down to the sides, through every enclosing cluster.
-  gathered.assign(gathered.size(), Rgb(0.0));
-  for (size_t i = 0; i < nodes.size(); ++i) {
-    const ClusterNode& node = nodes[i];
-    const ChannelVectors& r = received_[i];
-    if (node.is_leaf()) {
-      const std::int32_t side = tree.sides()[node.first];
-      const dvec3 n = hierarchy.normal(hierarchy.element(side));
-      gathered[static_cast<size_t>(side)] =
-          glm::max(Rgb(glm::dot(n, r[0]), glm::dot(n, r[1]), glm::dot(n, r[2])), Rgb(0.0));
-      continue;
-    }
-    for (std::int32_t child : node.child)
-      for (int c = 0; c < 3; ++c) received_[static_cast<size_t>(child)][static_cast<size_t>(c)] += r[static_cast<size_t>(c)];
+    const std::int32_t side = tree.sides()[tree.node(link.receiver).first];
+    const double cosine = std::max(0.0, -glm::dot(hierarchy.normal(hierarchy.element(side)), w));
+    Rgb& g = gathered[static_cast<size_t>(side)];
+    for (int c = 0; c < 3; ++c)
+      g[c] += static_cast<double>(link.coupling) * cosine * std::max(0.0, glm::dot(p[static_cast<size_t>(c)], w));
   }
 }
 

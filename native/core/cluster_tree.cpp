@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace radiosity {
 namespace {
@@ -41,16 +42,15 @@ std::int32_t ClusterTree::build(const Hierarchy& hierarchy, std::uint32_t first,
   ClusterNode node;
   node.first = first;
   node.count = count;
-  node.lo = dvec3(std::numeric_limits<double>::infinity());
-  node.hi = -node.lo;
+  dvec3 lo(std::numeric_limits<double>::infinity()), hi = -lo;
   dvec3 weighted_normal(0.0);
   for (auto it = begin; it != end; ++it) {
     const Element& e = hierarchy.element(*it);
     dvec3 corners[4];
     const int n = hierarchy.corners(e, corners);
     for (int k = 0; k < n; ++k) {
-      node.lo = glm::min(node.lo, corners[k]);
-      node.hi = glm::max(node.hi, corners[k]);
+      lo = glm::min(lo, corners[k]);
+      hi = glm::max(hi, corners[k]);
     }
     weighted_normal += e.area * hierarchy.normal(e);
     node.centre += e.area * hierarchy.centre(e);
@@ -58,7 +58,7 @@ std::int32_t ClusterTree::build(const Hierarchy& hierarchy, std::uint32_t first,
     node.reflects |= luminance(hierarchy.reflectance(e)) > 0.0;
     node.sends |= luminance(hierarchy.reflectance(e)) > 0.0 || luminance(hierarchy.emission(e)) > 0.0;
   }
-  node.centre = node.area > 0.0 ? node.centre / node.area : 0.5 * (node.lo + node.hi);
+  node.centre = node.area > 0.0 ? node.centre / node.area : 0.5 * (lo + hi);
   for (auto it = begin; it != end; ++it) {
     dvec3 corners[4];
     const int n = hierarchy.corners(hierarchy.element(*it), corners);
@@ -88,9 +88,9 @@ std::int32_t ClusterTree::build(const Hierarchy& hierarchy, std::uint32_t first,
       }
       half = best;
     } else {
-      dvec3 lo(std::numeric_limits<double>::infinity()), hi = -lo;
-      for (auto it = begin; it != end; ++it) lo = glm::min(lo, centre_of(*it)), hi = glm::max(hi, centre_of(*it));
-      const dvec3 extent = hi - lo;
+      dvec3 low(std::numeric_limits<double>::infinity()), high = -low;
+      for (auto it = begin; it != end; ++it) low = glm::min(low, centre_of(*it)), high = glm::max(high, centre_of(*it));
+      const dvec3 extent = high - low;
       const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
       half = count / 2;
       // Ties broken by element id: the tree does not depend on the sort's luck.

@@ -14,7 +14,6 @@
 namespace radiosity {
 
 struct ClusterNode {
-  dvec3 lo{0.0}, hi{0.0};   // bounds of its sides
   dvec3 centre{0.0};        // area-weighted centroid of its sides
   double radius = 0.0;      // of the sphere about `centre` holding every side
   dvec3 axis{0.0};          // of the normals' cone (area-weighted mean normal)
@@ -31,6 +30,7 @@ class ClusterTree {
  public:
   // Over every top-level element that reflects or emits.
   explicit ClusterTree(const Hierarchy& hierarchy);
+  ClusterTree() = default;
 
   const std::vector<ClusterNode>& nodes() const { return nodes_; }
   const ClusterNode& node(std::int32_t n) const { return nodes_[static_cast<size_t>(n)]; }
@@ -40,6 +40,8 @@ class ClusterTree {
   // Cumulative area of sides()[0, i): area-proportional sampling within a node.
   const std::vector<double>& area_prefix() const { return area_prefix_; }
   std::size_t memory_bytes() const;
+  // Gives the memory back (no cluster links: the tree is not needed any more).
+  void release() { *this = ClusterTree(); }
 
  private:
   std::int32_t build(const Hierarchy& hierarchy, std::uint32_t first, std::uint32_t count);

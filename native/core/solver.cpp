@@ -1,8 +1,5 @@
 #include "core/solver.h"
 
-#include "core/cluster_links.h"
-#include "core/cluster_tree.h"
-
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -13,6 +10,9 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+
+#include "core/cluster_links.h"
+#include "core/cluster_tree.h"
 
 namespace radiosity {
 namespace {
@@ -38,14 +38,14 @@ ThresholdRange threshold_range(Oracle oracle) {
 
 enum class Split : std::uint8_t { None, Receiver, Emitter };
 
-// Far enough apart for a cluster link: the point-to-point kernel between the
-// clusters' centres errs by about (sum of radii / distance)^2 on what the link
-// carries, so finer quality asks for more distance.
+// Far enough apart for a cluster link: the emitter cluster's light is taken
+// as if it left from its centroid, which errs more the larger it looks from
+// the receiver, so finer quality asks for more distance.
 double cluster_separation(const SolveOptions& options) {
   return options.cluster_separation > 0.0 ? options.cluster_separation : 2.0 + 8.0 * options.quality;
 }
 
-// Shadow rays that must all pass before two clusters share one link.
+// Shadow rays that measure a cluster link's visible fraction.
 constexpr int kClusterRays = 16;
 
 class Solver {
@@ -237,6 +237,7 @@ void Solver::link_initially() {
       hierarchy_.element(clusters_.sides()[i]).has_links = 1;
   }
   cluster_links_.shrink_to_fit();
+  if (cluster_links_.empty()) clusters_.release();
   for (const Link& l : links_) hierarchy_.element(l.receiver).has_links = 1;
   links_.shrink_to_fit();
   hierarchy_.shrink_to_fit();

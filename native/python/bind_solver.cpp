@@ -110,7 +110,8 @@ py::dict stats_dict(const SolveStats& s) {
   d["link_bytes"] = s.link_bytes;
   d["peak_bytes"] = s.peak_bytes;
   d["bytes_per_element"] = s.elements ? static_cast<double>(s.element_bytes) / static_cast<double>(s.elements) : 0.0;
-  d["bytes_per_link"] = s.links ? static_cast<double>(s.link_bytes) / static_cast<double>(s.links) : 0.0;
+  const std::size_t all_links = s.links + s.cluster_links;
+  d["bytes_per_link"] = all_links ? static_cast<double>(s.link_bytes) / static_cast<double>(all_links) : 0.0;
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   d["peak_rss_bytes"] = static_cast<std::size_t>(usage.ru_maxrss) * 1024;
