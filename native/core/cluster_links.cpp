@@ -166,7 +166,8 @@ int children(const ClusterTree& tree, const PairOutcome& o, std::int32_t x, std:
 }  // namespace
 
 InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy, const RayScene& scene,
-                           double separation, int rays, const std::function<bool()>& cancelled) {
+                           double separation, int rays, const std::function<bool()>& cancelled,
+                           const std::function<void(double)>& progress) {
   InitialLinks links;
   if (tree.root() == kNone) return links;
   using Pair = std::pair<std::int32_t, std::int32_t>;
@@ -208,6 +209,7 @@ InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy, 
         }
       }
     });
+    if (progress) progress(static_cast<double>(end) / static_cast<double>(frontier.size()));
   }
   for (InitialLinks& part : found) {
     links.clusters.insert(links.clusters.end(), part.clusters.begin(), part.clusters.end());

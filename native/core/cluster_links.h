@@ -44,9 +44,11 @@ struct InitialLinks {
 };
 
 // The walk described above; `separation` > 1, `rays` shadow rays per cluster
-// link. Returns early (incomplete) once `cancelled` says so.
+// link. Returns early (incomplete) once `cancelled` says so; `progress`, if
+// set, hears the fraction of the walk done (from the walking thread).
 InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy, const RayScene& scene,
-                           double separation, int rays, const std::function<bool()>& cancelled);
+                           double separation, int rays, const std::function<bool()>& cancelled,
+                           const std::function<void(double)>& progress = {});
 
 // What every top-level element gathers through the cluster links, uniform
 // over the element (far light): indexed by element id, zero for the others.

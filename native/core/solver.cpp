@@ -216,8 +216,10 @@ std::vector<Link> Solver::evaluate_links(std::vector<Link>&& candidates) {
 // ordinary links (cluster_links.h).
 void Solver::link_initially() {
   const auto start = Clock::now();
+  // Progress: the walk is the first half of linking, evaluating face links the second.
   InitialLinks initial = link_clusters(clusters_, hierarchy_, *occluders_.rays, cluster_separation(options_),
-                                       kClusterRays, [this] { return cancelled(); });
+                                       kClusterRays, [this] { return cancelled(); },
+                                       [this](double done) { report("linking", 0.05 * done); });
   stats_.seconds_clustering = std::chrono::duration<double>(Clock::now() - start).count();
   // In blocks, so cancellation and progress stay prompt for large scenes.
   const size_t block = 65536;
@@ -227,7 +229,7 @@ void Solver::link_initially() {
     std::vector<Link> visible = evaluate_links(std::vector<Link>(candidates.begin() + static_cast<std::ptrdiff_t>(begin),
                                                                  candidates.begin() + static_cast<std::ptrdiff_t>(end)));
     links_.insert(links_.end(), visible.begin(), visible.end());
-    report("linking", 0.1 * static_cast<double>(end) / static_cast<double>(candidates.size()));
+    report("linking", 0.05 + 0.05 * static_cast<double>(end) / static_cast<double>(candidates.size()));
   }
   candidates = {};
   cluster_links_ = std::move(initial.clusters);

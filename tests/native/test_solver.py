@@ -435,6 +435,17 @@ class Cancellation(unittest.TestCase):
         self.assertTrue(all(0 <= p["fraction"] <= 1 for p in seen))
         self.assertEqual([p["pass"] for p in passes], list(range(len(passes))))
 
+    def test_linking_a_large_scene_reports_progress(self):
+        # The cluster walk and the face links each report as they go, so a
+        # progress bar moves during a long initial linking.
+        seen = []
+        rad.solve(box_field(1000).scene(rad), oracle="standard", quality=0.0, visibility="sampled",
+                  progress=seen.append)
+        linking = [p["fraction"] for p in seen if p["phase"] == "linking"]
+        self.assertGreater(sum(f <= 0.05 for f in linking), 2, "the walk reports")
+        self.assertGreater(sum(f > 0.05 for f in linking), 0, "the face links report")
+        self.assertEqual(linking, sorted(linking))
+
 
 class QualityRange(unittest.TestCase):
     def test_coarsest_refines_nothing_and_converges(self):
