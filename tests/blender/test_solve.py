@@ -227,6 +227,16 @@ class SolveCubeTest(unittest.TestCase):
         self.assertFalse(any(o.show_wire for o in bake.result_objects(scene)))
 
 
+class VisibilityHintTest(unittest.TestCase):
+    def test_slow_exact_linking_suggests_sampled_visibility(self):
+        hint = operators.visibility_hint("exact", {"seconds_linking": 42.0})
+        self.assertIn("Sampled", hint)
+        self.assertIn("42 s", hint)
+        self.assertEqual(operators.visibility_hint("exact", {"seconds_linking": 2.0}), "")
+        self.assertEqual(operators.visibility_hint("sampled", {"seconds_linking": 42.0}), "")
+        self.assertEqual(operators.visibility_hint("exact", {}), "")
+
+
 class FailureTest(unittest.TestCase):
     def solve_error(self):
         with self.assertRaises(RuntimeError) as caught:
