@@ -132,9 +132,10 @@ FormFactorGradient unoccluded(const LinkEvaluator& evaluator, const dvec3& x, co
 // those links sum to zero), so the furnace stays exact. It goes only to the
 // samples in front of the emitter's plane (F_pq counts only that part of the
 // receiver; samples behind it stay dark, and the others carry the whole
-// delta), scaled by each one's visible fraction, so hidden samples stay dark.
-// A sample can end a little below zero where F falls steeply; the gather's sum
-// is what matters and the output clamps at zero.
+// delta). A sample can end a little below zero where F falls steeply; the
+// gather's sum is what matters and the output clamps at zero. Where some
+// sample is partly hidden, the samples are scaled by F_pq / average instead
+// (see below).
 void conserve_energy(const Element& receiver, const LinkEnds& ends, bool unoccluded, SampleValues& values) {
   std::array<Rgb, kMaxSamples> open{}, in_front{};
   double visible[kMaxSamples] = {};
@@ -149,6 +150,17 @@ void conserve_energy(const Element& receiver, const LinkEnds& ends, bool unocclu
   // 1e-8: far pairs need fewer quadrature points than the kernel's default.
   const double exact = patch_form_factor(ends.receiver_polygon(), ends.emitter_polygon(), 1e-8);
   if (!(average > 0.0) || !(exact >= 0.0) || !(front > 0.0)) return;
+  bool all_seen = true;
+  for (int s = 0; s < ends.ns; ++s) all_seen &= open[static_cast<size_t>(s)].x <= 0.0 || visible[s] >= 1.0 - 1e-9;
+  if (!all_seen) {
+    // Part hidden: the shift that corrects the open samples' average could
+    // outweigh what the visible samples carry (a floor whose centre sample is
+    // under a box would go below zero and lose all its light). Scale them
+    // instead: the link carries F_pq times the samples' visible share.
+    const double scale = exact / average;
+    for (int s = 0; s < ends.ns; ++s) values.value[s] *= scale;
+    return;
+  }
   for (int s = 0; s < ends.ns; ++s) values.value[s] += (exact - average) * visible[s] / front;
 }
 

@@ -121,6 +121,15 @@ def floating_light_box(rho, gap):
 LIGHT_POWER = math.pi * np.array([4, 3, 2]) * 0.4
 
 
+def box_triangles(lo, hi):
+    """The triangles of an axis-aligned box without its bottom, for the visibility API."""
+    b = SceneBuilder()
+    b.box(lo, hi, skip=(0,))
+    a = b.arrays()
+    quads = a["positions"][a["face_vertices"].reshape(-1, 4)]
+    return np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
+
+
 def absorbed_power(builder, result, faces=None):
     rho = builder.arrays()["reflectance"][result.source_face]
     absorbed = math.pi * ((1 - rho) * result.irradiance * polygon_areas(result)[:, None])
@@ -138,6 +147,39 @@ class EnergyBalance(unittest.TestCase):
             for quality in (0.0, 0.5):
                 result = rad.solve(b.scene(rad), oracle="standard", quality=quality)
                 np.testing.assert_allclose(absorbed_power(b, result), LIGHT_POWER, rtol=1e-6)
+
+    def test_a_receiver_whose_brightest_sample_is_hidden_keeps_its_light(self):
+        # Unrefined, a floor sees a ceiling light from its corners, and its
+        # centre sample sits under a box. Shifting the samples to the exact
+        # unoccluded exchange took more than the visible corners carry: the
+        # floor went to zero (black in the render of a room of boxes). Scaled
+        # instead, it keeps the samples' visible share of the exact exchange.
+        # A large floor under a small light: the centre sample carries most of
+        # the samples' average, far more than the exact exchange.
+        def floor_gathers(with_box):
+            b = SceneBuilder()
+            floor = b.polygon([(0, 0, 0), (20, 0, 0), (20, 20, 0), (0, 20, 0)], rho=0.5, two_sided=False)
+            b.polygon(light, rho=0.0, emission=10.0, two_sided=False)
+            if with_box:
+                b.box(*box, rho=1e-9, skip=(0,))
+            result = rad.solve(b.scene(rad), oracle="standard", quality=0.0)
+            self.assertTrue(np.all(result.radiance >= 0.0))
+            on_floor = result.source_face == floor
+            return (result.irradiance[on_floor, 0] * polygon_areas(result)[on_floor]).sum() / 400.0
+
+        light = [(9.5, 9.5, 2), (9.5, 10.5, 2), (10.5, 10.5, 2), (10.5, 9.5, 2)]
+        box = ((9.8, 9.8, 0), (10.2, 10.2, 0.3))
+        up = np.array([0, 0, 1.0])
+        centre = np.array([10.0, 10.0, 1e-6])
+        hidden, _ = rad.visible_form_factor(centre, up, np.array(light), box_triangles(*box))
+        self.assertEqual(hidden, 0.0)
+        corners = sum(rad.form_factor(np.array([x, y, 1e-6]), up, np.array(light))
+                      for x in (1e-5, 20 - 1e-5) for y in (1e-5, 20 - 1e-5))
+        # Interpolant weights: 5/36 per corner, 4/9 for the centre.
+        visible_share = (5 / 36) * corners / ((5 / 36) * corners + (4 / 9) * rad.form_factor(centre, up, np.array(light)))
+        open_floor = floor_gathers(False)  # 10 x the exact patch form factor
+        self.assertGreater(open_floor, 0.0)
+        np.testing.assert_allclose(floor_gathers(True), visible_share * open_floor, rtol=1e-4)
 
     def test_open_box_emitted_equals_absorbed_plus_escaped(self):
         # leaf_links="all" hands near-field links down at both ends, so every
