@@ -6,6 +6,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/random.h"
+
 namespace radiosity {
 namespace {
 
@@ -20,21 +22,9 @@ bool none_facing(const ClusterNode& node, const dvec3& w, double cone) {
   return angle - node.spread - cone > 0.5 * std::numbers::pi + 1e-6;
 }
 
-// SplitMix64: a small, fast, seedable generator.
-struct Random {
-  std::uint64_t state;
-  std::uint64_t next() {
-    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
-};
-
 // A point uniformly distributed over the node's sides (area-weighted).
 dvec3 random_point(const ClusterTree& tree, const Hierarchy& hierarchy, const ClusterNode& node,
-                   Random& random, std::uint32_t& face) {
+                   SplitMix64& random, std::uint32_t& face) {
   const auto& prefix = tree.area_prefix();
   const double target = prefix[node.first] + random.uniform() * (prefix[node.first + node.count] - prefix[node.first]);
   const auto it = std::upper_bound(prefix.begin() + node.first + 1, prefix.begin() + node.first + node.count, target);
@@ -63,7 +53,7 @@ struct PairOutcome {
 // many pass. Seeded by the pair: the answer does not depend on threads.
 int passing_rays(const ClusterTree& tree, const Hierarchy& hierarchy, const RayScene& scene,
                  std::int32_t receiver, std::int32_t emitter, int rays) {
-  Random random{(static_cast<std::uint64_t>(static_cast<std::uint32_t>(receiver)) << 32) |
+  SplitMix64 random{(static_cast<std::uint64_t>(static_cast<std::uint32_t>(receiver)) << 32) |
                 static_cast<std::uint32_t>(emitter)};
   int passed = 0;
   for (int k = 0; k < rays; ++k) {

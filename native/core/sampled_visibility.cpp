@@ -4,22 +4,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/random.h"
+
 namespace radiosity {
-namespace {
-
-// SplitMix64: small, fast, and good enough to jitter strata.
-struct SplitMix64 {
-  std::uint64_t state;
-  std::uint64_t next() {
-    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
-};
-
-}  // namespace
 
 EmitterSamples sample_emitter(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter,
                               const SampledVisibilityOptions& options) {

@@ -43,6 +43,16 @@ void grid(Arrays& a, double z, int n, bool up, double rho, double emit, bool bot
     for (int j = 0; j < n; ++j) a.square(dvec3(0.3 * i, 0.3 * j, z), 0.2, up, rho, emit, both_sides);
 }
 
+// A scene with its hierarchy, cluster tree and occluders, linked at `separation`.
+struct Linked {
+  explicit Linked(const Arrays& a) : scene(a.scene()), h(scene), tree(h), occluders(make_scene_occluders(scene)) {}
+  InitialLinks link(double separation) const { return link_clusters(tree, h, *occluders.rays, separation, 16, {}); }
+  Scene scene;
+  Hierarchy h;
+  ClusterTree tree;
+  SceneOccluders occluders;
+};
+
 TEST(ClusterTree, EverySideInOneLeafAndNodesHoldTheirSides) {
   Arrays a;
   grid(a, 0.0, 5, true, 0.5, 0.0, true);
@@ -88,11 +98,9 @@ TEST(ClusterLinks, FarGridsShareLinksNearOnesDoNot) {
   Arrays a;
   grid(a, 0.0, 4, true, 0.5, 0.0);
   grid(a, 20.0, 4, false, 0.5, 1.0);
-  const Scene scene = a.scene();
-  const Hierarchy h(scene);
-  const ClusterTree tree(h);
-  const SceneOccluders occluders = make_scene_occluders(scene);
-  const InitialLinks far = link_clusters(tree, h, *occluders.rays, 2.0, 16, {});
+  const Linked linked(a);
+  const ClusterTree& tree = linked.tree;
+  const InitialLinks far = linked.link(2.0);
   EXPECT_GT(far.clusters.size(), 0u);
   EXPECT_LT(far.clusters.size() + far.elements.size(), 2u * 16 * 16);
   for (const ClusterLink& l : far.clusters) {
@@ -100,7 +108,7 @@ TEST(ClusterLinks, FarGridsShareLinksNearOnesDoNot) {
     EXPECT_NEAR(glm::length(dvec3(l.direction[0], l.direction[1], l.direction[2])), 1.0, 1e-6);
   }
   // Infinitely demanding separation: only pairs of sides.
-  const InitialLinks pairs = link_clusters(tree, h, *occluders.rays, std::numeric_limits<double>::infinity(), 16, {});
+  const InitialLinks pairs = linked.link(std::numeric_limits<double>::infinity());
   EXPECT_EQ(pairs.clusters.size(), 0u);
   EXPECT_EQ(pairs.elements.size(), 2u * 16 * 16);  // each grid lights the other (both reflect)
 }
@@ -112,11 +120,10 @@ TEST(ClusterLinks, FarLightMatchesThePointFormFactorsOfItsSides) {
   Arrays a;
   grid(a, 0.0, 4, true, 0.5, 0.0);
   grid(a, 20.0, 4, false, 0.0, 2.0);
-  const Scene scene = a.scene();
-  const Hierarchy h(scene);
-  const ClusterTree tree(h);
-  const SceneOccluders occluders = make_scene_occluders(scene);
-  const InitialLinks links = link_clusters(tree, h, *occluders.rays, 2.0, 16, {});
+  const Linked linked(a);
+  const Hierarchy& h = linked.h;
+  const ClusterTree& tree = linked.tree;
+  const InitialLinks links = linked.link(2.0);
   ASSERT_EQ(links.elements.size(), 0u);
   std::vector<Rgb> radiance(h.elements().size(), Rgb(0.0));
   for (size_t e = 0; e < h.elements().size(); ++e) radiance[e] = h.emission(h.element(static_cast<std::int32_t>(e)));
@@ -145,11 +152,10 @@ TEST(ClusterLinks, SidesHiddenFromTheLightsGetNoLinksFromThem) {
   const dvec3 lo(0.0, 0.0, 10.0);
   a.square(lo, 1.0, false, 0.5, 0.0, true);                 // bottom, two-sided
   a.square(lo + dvec3(0.25, 0.25, 0.5), 0.5, false, 0.5, 0.0);  // hidden, facing down
-  const Scene scene = a.scene();
-  const Hierarchy h(scene);
-  const ClusterTree tree(h);
-  const SceneOccluders occluders = make_scene_occluders(scene);
-  const InitialLinks links = link_clusters(tree, h, *occluders.rays, 2.0, 16, {});
+  const Linked linked(a);
+  const Hierarchy& h = linked.h;
+  const ClusterTree& tree = linked.tree;
+  const InitialLinks links = linked.link(2.0);
   const std::int32_t inner_bottom = h.root(16, 1), inner_top = h.root(17, 0);
   const auto from_grid = [&](std::int32_t node) {
     const ClusterNode& n = tree.node(node);
