@@ -13,6 +13,9 @@
 
 #include "core/cluster_links.h"
 #include "core/cluster_tree.h"
+#include "core/gather.h"
+#include "core/convergence.h"
+#include "core/energy_balance.h"
 
 namespace radiosity {
 namespace {
@@ -38,6 +41,10 @@ ThresholdRange threshold_range(Oracle oracle) {
 
 enum class Split : std::uint8_t { None, Receiver, Emitter };
 
+// Emitted power over area divided by the mean radiance of the lit sides, in
+// the calibration room (threshold_range), measured: keeps its refinement.
+constexpr double kAdaptationCalibration = 0.52;
+
 // Far enough apart for a cluster link: the emitter cluster's light is taken
 // as if it left from its centroid, which errs more the larger it looks from
 // the receiver, so finer quality asks for more distance.
@@ -61,7 +68,6 @@ class Solver {
         occluders_(make_scene_occluders(scene)),
         evaluator_{hierarchy_, occluders_, options.visibility, options.rays, options.oracle,
                    oracle_geometric_scale(options.oracle, scene.total_area)},
-        reference_radiance_(scene.reference_radiance()),
         min_area_(options.min_element_area * scene.total_area),
         clusters_(hierarchy_) {}
 
@@ -79,6 +85,7 @@ class Solver {
   void link_initially();
   std::vector<Link> evaluate_links(std::vector<Link>&& candidates);
   bool refine(double threshold);
+  double adaptation_radiance() const;
   Split choose_split(const Link& link, double threshold) const;
   bool can_split(std::int32_t e) const { return hierarchy_.element(e).area / 4.0 >= min_area_; }
   bool near_field(const Link& link, bool receiver_end) const;
@@ -98,12 +105,14 @@ class Solver {
   Hierarchy hierarchy_;
   SceneOccluders occluders_;
   LinkEvaluator evaluator_;
-  const double reference_radiance_;
+  // Brightness the oracles' thresholds are relative to (refine()).
+  double reference_radiance_ = 0.0;
   const double min_area_;
   std::vector<Link> links_;
   // Links grouped by receiver for the gather, and which links they describe.
   std::vector<std::uint32_t> offset_, order_;
-  std::vector<Rgb> source_;  // radiance per element as the last gather read it
+  std::vector<Rgb> source_;  // radiance per element as the last gather read it (what each sends)
+  EnergyBalance balance_;     // corrections of what is received and sent (energy_balance.h)
   ClusterTree clusters_;
   std::vector<ClusterLink> cluster_links_;
   ClusterGather cluster_gather_;
@@ -135,7 +144,8 @@ void Solver::report(const std::string& phase, double fraction) {
 void Solver::track_memory() {
   stats_.element_bytes = hierarchy_.memory_bytes() + offset_.capacity() * sizeof(std::uint32_t) +
                          source_.capacity() * sizeof(Rgb) + clusters_.memory_bytes() +
-                         cluster_gather_.memory_bytes() + far_light_.capacity() * sizeof(Rgb);
+                         cluster_gather_.memory_bytes() + far_light_.capacity() * sizeof(Rgb) +
+                         balance_.memory_bytes();
   stats_.link_bytes = links_.capacity() * sizeof(Link) + order_.capacity() * sizeof(std::uint32_t) +
                       cluster_links_.capacity() * sizeof(ClusterLink);
   stats_.peak_bytes = std::max(stats_.peak_bytes, stats_.element_bytes + stats_.link_bytes);
@@ -260,6 +270,27 @@ bool Solver::near_field(const Link& link, bool receiver_end) const {
   return gap < 2.0 * (receiver_end ? rp : rq);
 }
 
+// The mean radiance of the lit and emitting sides, as the solution stands:
+// the brightness an eye adapts to, which thresholds are relative to. With
+// the emitted power over the area instead, a white room (whose mean radiance
+// is 1 / (1 - rho) times larger) refined as if seen ten to a hundred times
+// brighter: 5.5 million links at rho = 0.9. Scaled by kAdaptationCalibration
+// so that the test room the thresholds were calibrated on (see
+// threshold_range) refines as before.
+double Solver::adaptation_radiance() const {
+  double light = 0.0, area = 0.0;
+  for (size_t r = 0; r < hierarchy_.root_count(); ++r) {
+    const std::int32_t root = hierarchy_.root(static_cast<std::uint32_t>(r / 2), static_cast<int>(r % 2));
+    if (root == kNone) continue;
+    const Element& e = hierarchy_.element(root);
+    if (!e.has_links && !(luminance(hierarchy_.emission(e)) > 0.0)) continue;
+    light += e.area * luminance(e.radiance);
+    area += e.area;
+  }
+  const double mean = area > 0.0 ? light / area : 0.0;
+  return mean > 0.0 ? kAdaptationCalibration * mean : scene_.reference_radiance();
+}
+
 // The refinement policy shared by every oracle (DESIGN s5): split the larger
 // of receiver and emitter unless it is at the minimum size, then the other.
 Split Solver::choose_split(const Link& link, double threshold) const {
@@ -279,6 +310,7 @@ Split Solver::choose_split(const Link& link, double threshold) const {
 // whether anything changed.
 bool Solver::refine(double threshold) {
   if (!std::isfinite(threshold)) return false;
+  reference_radiance_ = adaptation_radiance();
   bool changed = false;
   while (!cancelled() && !budget_hit_ && !out_of_time()) {
     std::vector<Split> decision(links_.size(), Split::None);
@@ -387,96 +419,9 @@ void Solver::group_links() {
       l.emitter_shape = emitter_shape(hierarchy_, emitter, std::span<const dvec3>(receiver, static_cast<size_t>(n)));
     }
   });
+  balance_.update(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, clusters_, cluster_links_,
+                  cluster_gather_);
   grouped_version_ = links_version_;
-}
-
-// What an element gathers through its own links, per sample: H[s] = sum of
-// F_s L_q, with the emitters' radiances of the previous iteration (Jacobi), so
-// the result does not depend on the order elements are visited in. Computed
-// where push/pull needs it instead of stored per element.
-struct LinkGather {
-  const Hierarchy& hierarchy;
-  const std::vector<Link>& links;
-  const std::vector<std::uint32_t>& offset;
-  const std::vector<std::uint32_t>& order;
-  const std::vector<Rgb>& source;
-
-  std::array<Rgb, kMaxSamples> operator()(std::int32_t e) const {
-    std::array<Rgb, kMaxSamples> h{};
-    for (std::uint32_t k = offset[static_cast<size_t>(e)]; k < offset[static_cast<size_t>(e) + 1]; ++k) {
-      const Link& l = links[order[k]];
-      const Rgb radiance = sent_radiance(hierarchy, l.emitter, source, l.emitter_shape);
-      for (size_t s = 0; s < kMaxSamples; ++s) h[s] += static_cast<double>(l.form_factor[s]) * radiance;
-    }
-    return h;
-  }
-};
-
-// Push H down with each element's interpolant, pull L up as area averages.
-// Returns the relative change of radiance, area-weighted over leaves.
-struct Change {
-  double delta = 0.0, total = 0.0;
-};
-
-Rgb push_pull_element(Hierarchy& h, std::int32_t index, const std::array<Rgb, kMaxSamples>& down,
-                      const LinkGather& gather, Change& change,
-                      std::vector<std::array<Rgb, kMaxSamples>>* leaf_out) {
-  Element& e = h.element(index);
-  std::array<Rgb, kMaxSamples> total = gather(index);
-  for (size_t s = 0; s < kMaxSamples; ++s) total[s] += down[s];
-  Rgb radiance;
-  if (e.is_leaf()) {
-    radiance = h.emission(e) + h.reflectance(e) * glm::max(Interpolant::average(e.corner_count, total), Rgb(0.0));
-    change.delta += std::abs(luminance(radiance) - luminance(e.radiance)) * e.area;
-    change.total += luminance(radiance) * e.area;
-    if (leaf_out) (*leaf_out)[static_cast<size_t>(index)] = total;
-  } else {
-    glm::dvec3 sum(0.0);
-    double area = 0.0;
-    const std::int32_t first = e.first_child;
-    const int corners = e.corner_count;
-    // The children's interpolants do not reproduce the parent's bubble exactly:
-    // a uniform shift makes them carry the same total, so pushing light down
-    // neither makes nor loses energy.
-    std::array<std::array<Rgb, kMaxSamples>, 4> child_down{};
-    glm::dvec3 pushed(0.0);
-    for (int c = 0; c < 4; ++c) {
-      for (int s = 0; s <= corners; ++s)
-        child_down[static_cast<size_t>(c)][static_cast<size_t>(s)] = Interpolant::at_child_sample(corners, total, c, s);
-      pushed += h.element(first + c).area * glm::dvec3(Interpolant::average(corners, child_down[static_cast<size_t>(c)]));
-    }
-    const Rgb shift = Interpolant::average(corners, total) - Rgb(pushed / e.area);
-    for (int c = 0; c < 4; ++c) {
-      for (int s = 0; s <= corners; ++s) child_down[static_cast<size_t>(c)][static_cast<size_t>(s)] += shift;
-      const Rgb child = push_pull_element(h, first + c, child_down[static_cast<size_t>(c)], gather, change, leaf_out);
-      const double child_area = h.element(first + c).area;
-      sum += child_area * glm::dvec3(child);
-      area += child_area;
-    }
-    radiance = Rgb(sum / area);
-  }
-  h.element(index).radiance = radiance;
-  return radiance;
-}
-
-// `far_light`: what each top-level element gathers through cluster links,
-// uniform over it (or empty).
-double push_pull_all(Hierarchy& h, const LinkGather& gather, const std::vector<Rgb>& far_light,
-                     std::vector<std::array<Rgb, kMaxSamples>>* leaf_out) {
-  const size_t roots = h.root_count();
-  std::vector<Change> changes(roots);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, roots), [&](const auto& range) {
-    for (size_t r = range.begin(); r != range.end(); ++r) {
-      const std::int32_t root = h.root(static_cast<std::uint32_t>(r / 2), static_cast<int>(r % 2));
-      if (root == kNone) continue;
-      std::array<Rgb, kMaxSamples> down{};
-      if (!far_light.empty()) down.fill(far_light[static_cast<size_t>(root)]);
-      push_pull_element(h, root, down, gather, changes[r], leaf_out);
-    }
-  });
-  Change sum;
-  for (const Change& c : changes) sum.delta += c.delta, sum.total += c.total;
-  return sum.total > 0.0 ? sum.delta / sum.total : 0.0;
 }
 
 void Solver::gather_far_light() {
@@ -488,13 +433,9 @@ void Solver::gather_far_light() {
 // One Jacobi iteration: the links read the radiances as they are now.
 double Solver::gather_push_pull() {
   group_links();
-  const auto& elements = hierarchy_.elements();
-  source_.resize(elements.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, elements.size()), [&](const auto& range) {
-    for (size_t e = range.begin(); e != range.end(); ++e) source_[e] = elements[e].radiance;
-  });
+  balance_.sent_radiances(hierarchy_, source_);
   gather_far_light();
-  return push_pull_all(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_, nullptr);
+  return push_pull(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_, balance_.down_scale());
 }
 
 
@@ -506,6 +447,7 @@ double Solver::iterate(double threshold, int max_iterations, double tolerance) {
   // only change once the radiances they read have moved (a converging
   // high-albedo scene iterates hundreds of times without new refinement).
   double drift = std::numeric_limits<double>::infinity();
+  TailExtrapolation tail;
   for (int i = 0; i < max_iterations && !cancelled(); ++i) {
     bool refined = false;
     if (drift > 1e-3) {
@@ -514,11 +456,14 @@ double Solver::iterate(double threshold, int max_iterations, double tolerance) {
     }
     if (cancelled()) break;
     const auto start = Clock::now();
+    tail.before(hierarchy_);
     residual = gather_push_pull();
+    const bool extrapolated = tail.after(hierarchy_, residual, refined);
     stats_.seconds_gather += std::chrono::duration<double>(Clock::now() - start).count();
     ++stats_.iterations;
     stats_.residual = residual;
     if (std::isfinite(drift)) drift += residual;
+    if (extrapolated) continue;  // not converged until an iteration confirms it
     // A pass cut short by the element budget is the last: converge it fully.
     if (!refined && residual < (budget_hit_ ? options_.tolerance : tolerance)) break;
     if (out_of_time() && !refined && i > 0 && residual < 1e3 * tolerance) break;
@@ -534,7 +479,7 @@ void Solver::snapshot(double threshold) {
   source_.resize(hierarchy_.elements().size(), Rgb(0.0));
   group_links();
   gather_far_light();
-  push_pull_all(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_, &leaf);
+  push_pull(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_, balance_.down_scale(), &leaf);
   result_.mesh = make_output_mesh(hierarchy_, leaf);
   stats_.threshold = threshold;
 }
