@@ -30,7 +30,7 @@ dvec3 random_point(const ClusterTree& tree, const Hierarchy& hierarchy, const Cl
   const auto it = std::upper_bound(prefix.begin() + node.first + 1, prefix.begin() + node.first + node.count, target);
   const auto index = static_cast<size_t>(it - prefix.begin()) - 1;
   const Element& e = hierarchy.element(tree.sides()[index]);
-  face = hierarchy.patch_of(e).face;
+  face = hierarchy.patch_of(e).surface;
   dvec3 c[4];
   const int n = hierarchy.corners(e, c);
   dvec3 a = c[0], b = c[1], t = c[2];
@@ -87,7 +87,9 @@ PairOutcome classify(const ClusterTree& tree, const Hierarchy& hierarchy, const 
     // Facing is judged along the centres' direction only: where the clusters
     // are far apart, a side seen at a grazing angle from part of the other
     // carries little light either way.
-    if (!both_leaves && d > separation * (rx.radius + ry.radius) && all_facing(ry, w, 0.0) &&
+    // Light straight from emitters, the brightest in any scene, always goes
+    // through face links (exact visibility at the receiver's samples).
+    if (!both_leaves && !ry.emits && d > separation * (rx.radius + ry.radius) && all_facing(ry, w, 0.0) &&
         all_facing(rx, -w, 0.0)) {
       // A cluster link ends on one side: the distance to the emitter cluster
       // is then that side's own (a receiving cluster would give the light of

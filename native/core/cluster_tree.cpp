@@ -19,11 +19,11 @@ int facing_class(const dvec3& n) {
 
 ClusterTree::ClusterTree(const Hierarchy& hierarchy) {
   for (std::uint32_t p = 0; p < hierarchy.scene().patches.size(); ++p) {
-    const Patch& patch = hierarchy.scene().patches[p];
-    if (!(luminance(patch.reflectance) > 0.0) && !(luminance(patch.emission) > 0.0)) continue;
     for (int side = 0; side < 2; ++side) {
       const std::int32_t root = hierarchy.root(p, side);
-      if (root != kNone) sides_.push_back(root);
+      if (root == kNone) continue;
+      const Element& e = hierarchy.element(root);
+      if (luminance(hierarchy.reflectance(e)) > 0.0 || luminance(hierarchy.emission(e)) > 0.0) sides_.push_back(root);
     }
   }
   if (sides_.empty()) return;
@@ -57,6 +57,7 @@ std::int32_t ClusterTree::build(const Hierarchy& hierarchy, std::uint32_t first,
     node.area += e.area;
     node.reflects |= luminance(hierarchy.reflectance(e)) > 0.0;
     node.sends |= luminance(hierarchy.reflectance(e)) > 0.0 || luminance(hierarchy.emission(e)) > 0.0;
+    node.emits |= luminance(hierarchy.emission(e)) > 0.0;
   }
   node.centre = node.area > 0.0 ? node.centre / node.area : 0.5 * (lo + hi);
   for (auto it = begin; it != end; ++it) {

@@ -23,6 +23,7 @@ struct ClusterNode {
   std::uint32_t first = 0, count = 0;  // its sides: ClusterTree::sides()[first, first + count)
   bool reflects = false;    // some side reflects (can receive)
   bool sends = false;       // some side emits or reflects
+  bool emits = false;       // some side emits
   bool is_leaf() const { return child[0] == kNone; }
 };
 

@@ -99,11 +99,38 @@ Rgb Interpolant::average(int corner_count, const std::array<Rgb, kMaxSamples>& v
   return Rgb((1 - bubble) * corners + bubble * glm::dvec3(values[static_cast<size_t>(corner_count)]));
 }
 
+namespace {
+
+// A corner of a top-level element: patches of the same side of one input face
+// (the triangles of an n-gon, the pieces of a face split by contact.h) share
+// their coinciding corners, so their elements meet without cracks and their
+// radiance is averaged there.
+struct CornerKey {
+  std::uint32_t face;
+  std::uint8_t face_side;
+  dvec3 position;
+  bool operator==(const CornerKey& o) const {
+    return face == o.face && face_side == o.face_side && position == o.position;
+  }
+};
+
+struct CornerHash {
+  size_t operator()(const CornerKey& k) const {
+    size_t h = std::hash<std::uint64_t>()((static_cast<std::uint64_t>(k.face) << 1) | k.face_side);
+    for (int i = 0; i < 3; ++i) h = h * 1000003u ^ std::hash<double>()(k.position[i]);
+    return h;
+  }
+};
+
+}  // namespace
+
 Hierarchy::Hierarchy(const Scene& scene) : scene_(&scene) {
   roots_.assign(2 * scene.patches.size(), kNone);
+  std::unordered_map<CornerKey, std::uint32_t, CornerHash> shared;
   for (std::uint32_t p = 0; p < scene.patches.size(); ++p) {
     const Patch& patch = scene.patches[p];
-    for (int side = 0; side < (patch.two_sided ? 2 : 1); ++side) {
+    for (int side = 0; side < 2; ++side) {
+      if (!patch.sides[static_cast<size_t>(side)].present) continue;
       Element e;
       e.patch = p;
       e.side = static_cast<std::uint8_t>(side);
@@ -111,11 +138,15 @@ Hierarchy::Hierarchy(const Scene& scene) : scene_(&scene) {
       e.area = patch.area;
       // Each side has its own vertices (its own radiance); the back side winds
       // the other way so its corners are counter-clockwise about its normal.
+      const PatchSide& shown = patch.sides[static_cast<size_t>(side)];
       for (int k = 0; k < patch.corner_count; ++k) {
         const int source = side == 0 ? k : (patch.corner_count - k) % patch.corner_count;
-        e.corner[static_cast<size_t>(k)] = add_vertex(patch.corners[static_cast<size_t>(source)]);
+        const dvec3 corner = patch.corners[static_cast<size_t>(source)] + dvec3(0.0);  // no -0.0 in the key
+        const auto [it, made] = shared.try_emplace(CornerKey{shown.face, shown.face_side, corner}, 0u);
+        if (made) it->second = add_vertex(corner);
+        e.corner[static_cast<size_t>(k)] = it->second;
       }
-      e.radiance = patch.emission;
+      e.radiance = patch.sides[static_cast<size_t>(side)].emission;
       roots_[2 * p + static_cast<size_t>(side)] = static_cast<std::int32_t>(elements_.size());
       elements_.push_back(e);
     }

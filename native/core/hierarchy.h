@@ -56,8 +56,9 @@ class Hierarchy {
   dvec3 normal(const Element& e) const {
     return e.side == 0 ? patch_of(e).normal : -patch_of(e).normal;
   }
-  Rgb reflectance(const Element& e) const { return patch_of(e).reflectance; }
-  Rgb emission(const Element& e) const { return patch_of(e).emission; }
+  const PatchSide& side_of(const Element& e) const { return patch_of(e).sides[e.side]; }
+  Rgb reflectance(const Element& e) const { return side_of(e).reflectance; }
+  Rgb emission(const Element& e) const { return side_of(e).emission; }
 
   // Corner positions, counter-clockwise about the side's normal.
   int corners(const Element& e, dvec3* out) const;

@@ -55,12 +55,12 @@ double distance_to_polygon(const dvec3& p, std::span<const dvec3> polygon) {
 SceneOccluders make_scene_occluders(const Scene& scene) {
   std::vector<Triangle> triangles;
   std::vector<std::uint32_t> face;
-  for (const Patch& p : scene.patches) {
+  for (const Patch& p : scene.occluders.empty() ? scene.patches : scene.occluders) {
     triangles.push_back({{p.corners[0], p.corners[1], p.corners[2]}});
-    face.push_back(p.face);
+    face.push_back(p.surface);
     if (p.corner_count == 4) {
       triangles.push_back({{p.corners[0], p.corners[2], p.corners[3]}});
-      face.push_back(p.face);
+      face.push_back(p.surface);
     }
   }
   SceneOccluders occluders;
@@ -233,8 +233,8 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo)
   // Shadow rays need no list of occluders: past the crossover, stop looking.
   const std::size_t limit = visibility == VisibilityMode::Sampled ? kRayCrossover : std::numeric_limits<std::size_t>::max();
   const ShaftCulling culling =
-      cull_shaft(occluders.shafts, ends.receiver_polygon(), hierarchy.patch_of(receiver).face,
-                 emitter_polygon, hierarchy.patch_of(emitter).face, limit);
+      cull_shaft(occluders.shafts, ends.receiver_polygon(), hierarchy.patch_of(receiver).surface,
+                 emitter_polygon, hierarchy.patch_of(emitter).surface, limit);
   timings.visibility += seconds_since(start);
   if (culling.visibility == ShaftVisibility::hidden) return false;
 
@@ -273,8 +273,8 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo)
       const SampledVisibilityOptions options{rays, static_cast<std::uint64_t>(s)};
       f = culling.truncated
               ? sampled_form_factor_gradient(x, ends.n, emitter_polygon, *occluders.rays, options,
-                                             hierarchy.patch_of(receiver).face,
-                                             hierarchy.patch_of(emitter).face)
+                                             hierarchy.patch_of(receiver).surface,
+                                             hierarchy.patch_of(emitter).surface)
               : sampled_form_factor_gradient(x, ends.n, emitter_polygon, candidates, options);
     }
     if (shared && !known) memo->add(vertex, f);
@@ -316,8 +316,8 @@ void LinkEvaluator::evaluate_emitter_siblings(std::span<Link> links, LinkTimings
                                               static_cast<size_t>(hierarchy.corners(parent, parent_corners)));
   auto start = Clock::now();
   const ShaftCulling culling =
-      cull_shaft(occluders.shafts, ends[0].receiver_polygon(), hierarchy.patch_of(receiver).face,
-                 parent_polygon, hierarchy.patch_of(parent).face);
+      cull_shaft(occluders.shafts, ends[0].receiver_polygon(), hierarchy.patch_of(receiver).surface,
+                 parent_polygon, hierarchy.patch_of(parent).surface);
   timings.visibility += seconds_since(start);
   if (culling.visibility == ShaftVisibility::hidden) return;
 

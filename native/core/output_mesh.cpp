@@ -1,5 +1,11 @@
 #include "core/output_mesh.h"
 
+#include <algorithm>
+#include <map>
+#include <unordered_map>
+
+#include <glm/gtc/type_precision.hpp>
+
 namespace radiosity {
 namespace {
 
@@ -12,6 +18,139 @@ void append_hanging(const Hierarchy& h, std::uint32_t a, std::uint32_t b,
   append_hanging(h, a, mid, out);
   out.push_back(mid);
   append_hanging(h, mid, b, out);
+}
+
+// Vertices of other top-level elements of the same surface side (the pieces
+// of a face split by contact.h, the triangles of an n-gon) that lie inside
+// the edges of an element: where pieces were cut at different places, a
+// corner of one lies on the edge of another (a T-junction), which the coarser
+// polygon must include to meet it without a crack.
+class ForeignVertices {
+ public:
+  explicit ForeignVertices(const Hierarchy& h);
+  // Appends, in order from a towards b, the foreign vertices strictly between
+  // the consecutive vertices a and b of a polygon of the element under `root`.
+  void append_between(std::int32_t root, std::uint32_t a, std::uint32_t b, std::vector<std::uint32_t>& out) const;
+
+ private:
+  struct OnEdge {
+    int edge;
+    double t;
+  };
+  struct RootEdges {
+    std::unordered_map<std::uint32_t, std::vector<OnEdge>> own;  // its boundary vertices
+    std::array<std::vector<std::pair<double, std::uint32_t>>, 4> foreign;  // per edge, sorted by t
+  };
+  std::unordered_map<std::int32_t, RootEdges> roots_;  // only roots that meet foreign vertices
+};
+
+void boundary_chain(const Hierarchy& h, std::uint32_t a, std::uint32_t b, std::vector<std::uint32_t>& out) {
+  out.push_back(a);
+  append_hanging(h, a, b, out);
+}
+
+ForeignVertices::ForeignVertices(const Hierarchy& h) {
+  const Scene& scene = h.scene();
+  // Top-level elements grouped by the side of the input face they show.
+  std::map<std::pair<std::uint32_t, std::uint8_t>, std::vector<std::int32_t>> groups;
+  for (std::uint32_t p = 0; p < scene.patches.size(); ++p) {
+    for (int side = 0; side < 2; ++side) {
+      const std::int32_t root = h.root(p, side);
+      if (root == kNone) continue;
+      const PatchSide& shown = h.side_of(h.element(root));
+      groups[{shown.face, shown.face_side}].push_back(root);
+    }
+  }
+  std::vector<std::uint32_t> chain;
+  for (const auto& [key, roots] : groups) {
+    if (roots.size() < 2) continue;
+    // Every boundary vertex of the group, in a grid of about one cell per
+    // top-level element edge.
+    std::vector<std::uint32_t> vertices;
+    double edge_sum = 0.0;
+    size_t edges = 0;
+    for (std::int32_t r : roots) {
+      const Element& e = h.element(r);
+      for (int k = 0; k < e.corner_count; ++k) {
+        const std::uint32_t a = e.corner[static_cast<size_t>(k)], b = e.corner[static_cast<size_t>((k + 1) % e.corner_count)];
+        chain.clear();
+        boundary_chain(h, a, b, chain);
+        vertices.insert(vertices.end(), chain.begin(), chain.end());
+        edge_sum += glm::length(h.vertex(b) - h.vertex(a));
+        ++edges;
+      }
+    }
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    const double cell = edge_sum / static_cast<double>(edges);
+    const auto cell_of = [&](const dvec3& p) {
+      return glm::i64vec3(glm::floor(p / cell));
+    };
+    struct CellHash {
+      size_t operator()(const glm::i64vec3& c) const {
+        return static_cast<size_t>(c.x * 73856093 ^ c.y * 19349663 ^ c.z * 83492791);
+      }
+    };
+    std::unordered_map<glm::i64vec3, std::vector<std::uint32_t>, CellHash> grid;
+    for (std::uint32_t v : vertices) grid[cell_of(h.vertex(v))].push_back(v);
+    for (std::int32_t r : roots) {
+      const Element& e = h.element(r);
+      RootEdges found;
+      bool any = false;
+      for (int k = 0; k < e.corner_count; ++k) {
+        const std::uint32_t a = e.corner[static_cast<size_t>(k)], b = e.corner[static_cast<size_t>((k + 1) % e.corner_count)];
+        const dvec3 pa = h.vertex(a), ab = h.vertex(b) - pa;
+        const double length2 = glm::dot(ab, ab);
+        chain.clear();
+        boundary_chain(h, a, b, chain);
+        chain.push_back(b);
+        for (std::uint32_t v : chain) found.own[v].push_back({k, glm::dot(h.vertex(v) - pa, ab) / length2});
+        const double tolerance = 1e-9 * std::sqrt(length2);
+        const glm::i64vec3 lo = cell_of(glm::min(pa, pa + ab) - dvec3(tolerance));
+        const glm::i64vec3 hi = cell_of(glm::max(pa, pa + ab) + dvec3(tolerance));
+        std::vector<std::pair<double, std::uint32_t>>& list = found.foreign[static_cast<size_t>(k)];
+        for (auto x = lo.x; x <= hi.x; ++x)
+          for (auto y = lo.y; y <= hi.y; ++y)
+            for (auto z = lo.z; z <= hi.z; ++z) {
+              const auto it = grid.find({x, y, z});
+              if (it == grid.end()) continue;
+              for (std::uint32_t v : it->second) {
+                if (std::find(chain.begin(), chain.end(), v) != chain.end()) continue;
+                const dvec3 d = h.vertex(v) - pa;
+                const double t = glm::dot(d, ab) / length2;
+                if (t <= 1e-9 || t >= 1.0 - 1e-9) continue;
+                if (glm::length(d - t * ab) > tolerance) continue;
+                list.emplace_back(t, v);
+              }
+            }
+        std::sort(list.begin(), list.end());
+        list.erase(std::unique(list.begin(), list.end()), list.end());
+        any |= !list.empty();
+      }
+      if (any) roots_.emplace(r, std::move(found));
+    }
+  }
+}
+
+void ForeignVertices::append_between(std::int32_t root, std::uint32_t a, std::uint32_t b,
+                                     std::vector<std::uint32_t>& out) const {
+  const auto it = roots_.find(root);
+  if (it == roots_.end()) return;
+  const RootEdges& r = it->second;
+  const auto on_a = r.own.find(a), on_b = r.own.find(b);
+  if (on_a == r.own.end() || on_b == r.own.end()) return;
+  for (const OnEdge& ea : on_a->second) {
+    for (const OnEdge& eb : on_b->second) {
+      if (ea.edge != eb.edge) continue;
+      const auto& list = r.foreign[static_cast<size_t>(ea.edge)];
+      const double lo = std::min(ea.t, eb.t), hi = std::max(ea.t, eb.t);
+      const size_t before = out.size();
+      for (const auto& [t, v] : list)
+        if (t > lo && t < hi) out.push_back(v);
+      if (ea.t > eb.t) std::reverse(out.begin() + static_cast<std::ptrdiff_t>(before), out.end());
+      return;
+    }
+  }
 }
 
 }  // namespace
@@ -29,7 +168,7 @@ OutputMesh make_output_mesh(const Hierarchy& h,
   const auto shown = [&](std::uint32_t patch, int side) {
     if (h.root(patch, side) == kNone) return false;
     if (lit[2 * patch + static_cast<size_t>(side)]) return true;
-    if (luminance(scene.patches[patch].emission) > 0.0) return true;
+    if (luminance(scene.patches[patch].sides[static_cast<size_t>(side)].emission) > 0.0) return true;
     return side == 0 && !lit[2 * patch + 1];
   };
 
@@ -63,7 +202,11 @@ OutputMesh make_output_mesh(const Hierarchy& h,
     }
     return remap[v];
   };
-  std::vector<std::uint32_t> polygon;
+  const ForeignVertices foreign(h);
+  std::vector<std::int32_t> root_of(elements.size());
+  for (size_t i = 0; i < elements.size(); ++i)  // parents come before children
+    root_of[i] = elements[i].parent == kNone ? static_cast<std::int32_t>(i) : root_of[static_cast<size_t>(elements[i].parent)];
+  std::vector<std::uint32_t> polygon, edge;
   for (size_t i = 0; i < elements.size(); ++i) {
     const Element& e = elements[i];
     if (!e.is_leaf() || !shown(e.patch, e.side)) continue;
@@ -71,13 +214,18 @@ OutputMesh make_output_mesh(const Hierarchy& h,
     for (int k = 0; k < e.corner_count; ++k) {
       const std::uint32_t a = e.corner[static_cast<size_t>(k)];
       const std::uint32_t b = e.corner[static_cast<size_t>((k + 1) % e.corner_count)];
-      polygon.push_back(a);
-      append_hanging(h, a, b, polygon);
+      edge.clear();
+      boundary_chain(h, a, b, edge);
+      edge.push_back(b);
+      for (size_t j = 0; j + 1 < edge.size(); ++j) {
+        polygon.push_back(edge[j]);
+        foreign.append_between(root_of[i], edge[j], edge[j + 1], polygon);
+      }
     }
     for (std::uint32_t v : polygon) mesh.face_vertices.push_back(output_vertex(v));
     mesh.face_sizes.push_back(static_cast<std::int32_t>(polygon.size()));
-    mesh.source_face.push_back(static_cast<std::int32_t>(h.patch_of(e).face));
-    mesh.source_side.push_back(e.side);
+    mesh.source_face.push_back(static_cast<std::int32_t>(h.side_of(e).face));
+    mesh.source_side.push_back(h.side_of(e).face_side);
     const Rgb mean = glm::max(Interpolant::average(e.corner_count, leaf_irradiance[i]), Rgb(0.0));
     mesh.irradiance.insert(mesh.irradiance.end(), {static_cast<float>(mean.x),
                                                    static_cast<float>(mean.y),

@@ -1,5 +1,7 @@
 #include "core/scene.h"
 
+#include "core/contact.h"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -48,12 +50,17 @@ struct PatchBuilder {
     Patch p;
     p.corner_count = static_cast<std::uint8_t>(corners.size());
     std::copy(corners.begin(), corners.end(), p.corners.begin());
-    p.two_sided = two_sided;
-    p.face = face;
+    p.surface = face;
     p.normal = area_normal / area;
     p.area = area;
-    p.reflectance = reflectance;
-    p.emission = emission;
+    for (std::uint8_t side = 0; side < 2; ++side) {
+      PatchSide& s = p.sides[side];
+      s.present = side == 0 || two_sided;
+      s.face = face;
+      s.face_side = side;
+      s.reflectance = reflectance;
+      s.emission = emission;
+    }
     scene.patches.push_back(p);
     ++made;
     return true;
@@ -233,9 +240,12 @@ Scene make_scene(const SceneArrays& a) {
   if (scene.patches.empty()) {
     fail("every face is degenerate (zero area); nothing to solve");
   }
+  mesh_contacts(scene);
   for (const Patch& p : scene.patches) {
+    if (!p.sides[0].present && !p.sides[1].present) continue;
     scene.total_area += p.area;
-    scene.emitted_power += luminance(p.emission) * p.area * (p.two_sided ? 2.0 : 1.0);
+    for (const PatchSide& side : p.sides)
+      if (side.present) scene.emitted_power += luminance(side.emission) * p.area;
   }
   if (!(scene.emitted_power > 0.0)) {
     fail("the scene has no emitter: at least one face needs an emission above 0");

@@ -25,16 +25,29 @@ struct SceneArrays {
   std::span<const std::uint8_t> two_sided;  // per face, or empty: every face two-sided
 };
 
-// A planar, convex piece of one input face: the top of the element hierarchy.
+// One side of a patch: the input face it shows and that face's material.
+// Each side is its own radiosity surface; a side that is not present has no
+// elements (the back of a one-sided face, or a side that coincides with
+// another face's, contact.h).
+struct PatchSide {
+  bool present = false;
+  std::uint32_t face = 0;       // index of the input face
+  std::uint8_t face_side = 0;   // 0: that face's front, 1: its back
+  Rgb reflectance{0.0};
+  Rgb emission{0.0};
+};
+
+// A planar, convex piece of surface: the top of the element hierarchy.
 struct Patch {
   std::array<dvec3, 4> corners{};  // counter-clockwise about `normal`
   std::uint8_t corner_count = 0;   // 3 or 4
-  bool two_sided = true;           // the back side receives, reflects and emits too
-  std::uint32_t face = 0;          // index of the input face
   dvec3 normal{0.0};               // front side
   double area = 0.0;
-  Rgb reflectance{0.0};
-  Rgb emission{0.0};
+  // Patches of one surface never shadow each other: the input face (pieces
+  // of a split face, the triangles of an n-gon), or for faces merged where
+  // they coincide, the first of them.
+  std::uint32_t surface = 0;
+  std::array<PatchSide, 2> sides{};  // front, back
 };
 
 struct SkippedFace {
@@ -44,7 +57,15 @@ struct SkippedFace {
 
 struct Scene {
   std::vector<Patch> patches;
+  // What casts shadows: the faces' own planar pieces before contact.h split
+  // them (a cut line must not be a crack light can slip through), without
+  // those merged into a coinciding face.
+  std::vector<Patch> occluders;
   std::vector<SkippedFace> skipped;
+  // Pairs of input faces that coincide somewhere (the same surface twice, as
+  // z-fighting shows it); each is counted once (contact.h).
+  std::vector<std::array<std::uint32_t, 2>> coincident;
+  std::size_t split_faces = 0;  // input faces split along what lies on or passes through them
   std::size_t face_count = 0;
   std::size_t vertex_count = 0;
   double total_area = 0.0;          // one side of every patch

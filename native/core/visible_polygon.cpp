@@ -600,6 +600,11 @@ struct PieceSum {
     if (!std::isfinite(out.gradient.x) || !std::isfinite(out.gradient.y) || !std::isfinite(out.gradient.z))
       out.gradient = dvec3(0.0);
     out.value = std::isfinite(out.value) ? std::clamp(out.value, 0.0, unoccluded) : 0.0;
+    // Below a billionth of the unoccluded value what is left is rounding: an
+    // occluder seen almost edge-on (a sample a millionth of its element from
+    // the occluder's plane, where a face passes through a wall) projects with
+    // that much error, and a closed box must stay closed.
+    if (out.value <= 1e-9 * unoccluded) out = FormFactorGradient{};
     return out;
   }
 };

@@ -253,7 +253,29 @@ void bind_solver(py::module_& m) {
         py::list out;
         for (const auto& k : s.skipped) out.append(py::make_tuple(k.face, k.reason));
         return out;
-      });
+      })
+      .def_property_readonly("coincident_faces", [](const Scene& s) {
+        py::list out;
+        for (const auto& pair : s.coincident) out.append(py::make_tuple(pair[0], pair[1]));
+        return out;
+      }, "pairs of input faces that coincide somewhere (each surface counted once)")
+      .def_property_readonly("split_faces", [](const Scene& s) { return s.split_faces; },
+                             "input faces split along what lies on or passes through them")
+      .def_property_readonly("patches", [](const Scene& s) {
+        py::list out;
+        for (const Patch& p : s.patches) {
+          py::list corners;
+          for (int k = 0; k < p.corner_count; ++k) {
+            const dvec3& c = p.corners[static_cast<size_t>(k)];
+            corners.append(py::make_tuple(c.x, c.y, c.z));
+          }
+          py::list sides;
+          for (const PatchSide& side : p.sides)
+            sides.append(side.present ? py::object(py::make_tuple(side.face, side.face_side)) : py::object(py::none()));
+          out.append(py::dict(py::arg("corners") = corners, py::arg("area") = p.area, py::arg("sides") = sides));
+        }
+        return out;
+      }, "the planar pieces solved: corners, area, and per side (front, back) the (face, face side) it shows or None");
 
   py::class_<PyResult>(m, "Result", "The solved leaf mesh with per-vertex radiance.")
       .def_readonly("positions", &PyResult::positions, "(V, 3) float64 vertex positions")

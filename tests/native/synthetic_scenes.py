@@ -53,12 +53,14 @@ class SceneBuilder:
                          a["emission"] * emission_scale, a["two_sided"])
 
 
-def room_with_blocker(light=5.0):
-    """A 4 x 4 x 3 room, a square ceiling light facing down, and a floating 1.2 m
-    square plate at 1 m under it: umbra, penumbra and lit floor, no contact."""
+def room_with_blocker(light=5.0, gap=0.01):
+    """A 4 x 4 x 3 room, a square ceiling light facing down `gap` under the
+    ceiling, and a floating 1.2 m square plate at 1 m under it: umbra,
+    penumbra and lit floor."""
     b = SceneBuilder()
     room = b.box((0, 0, 0), (4, 4, 3), rho=0.6, inward=True)
-    light_face = b.polygon([(1.7, 1.7, 2.99), (1.7, 2.3, 2.99), (2.3, 2.3, 2.99), (2.3, 1.7, 2.99)],
+    z = 3.0 - gap
+    light_face = b.polygon([(1.7, 1.7, z), (1.7, 2.3, z), (2.3, 2.3, z), (2.3, 1.7, z)],
                            rho=0.0, emission=light, two_sided=False)
     plate = b.polygon([(1.4, 1.4, 1.0), (2.6, 1.4, 1.0), (2.6, 2.6, 1.0), (1.4, 2.6, 1.0)], rho=0.5)
     return b, dict(room=room, light=light_face, blocker=[plate])

@@ -1,0 +1,411 @@
+#include "core/contact.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "core/scene_bvh.h"
+#include "core/triangle.h"
+
+namespace radiosity {
+namespace {
+
+constexpr double kParallelCosine = 0.99619469809174553;  // cos 5 degrees
+constexpr double kCoverGap = 0.1;           // of the smaller face's diameter
+constexpr double kFootGap = 0.01;           // of the touching face's diameter
+constexpr double kCoincident = 1e-5;        // of the larger face's diameter
+constexpr double kCoincidentScene = 1e-6;   // of the scene's diameter
+constexpr double kThinnest = 1e-4;          // of the cut face's diameter
+
+double cross2(const dvec2& a, const dvec2& b) { return a.x * b.y - a.y * b.x; }
+
+// A corner of a piece: in the plane of the patch being cut, and in space
+// (kept exactly for the patch's own corners, interpolated along the edge it
+// splits for the others, so that pieces sharing a corner share it exactly).
+struct Vertex {
+  dvec2 p;
+  dvec3 x;
+};
+using Polygon2 = std::vector<Vertex>;  // convex, counter-clockwise in the frame
+
+struct Frame {
+  dvec3 origin{0.0}, u{0.0}, v{0.0}, n{0.0};
+  dvec2 to2(const dvec3& x) const {
+    const dvec3 d = x - origin;
+    return {glm::dot(d, u), glm::dot(d, v)};
+  }
+};
+
+Frame frame_of(const Patch& p) {
+  Frame f;
+  f.origin = p.corners[0];
+  f.n = p.normal;
+  f.u = glm::normalize(p.corners[1] - p.corners[0]);
+  f.v = glm::cross(f.n, f.u);
+  return f;
+}
+
+double diameter_of(const Patch& p) {
+  double d = 0.0;
+  for (int i = 0; i < p.corner_count; ++i)
+    for (int j = i + 1; j < p.corner_count; ++j) d = std::max(d, glm::length(p.corners[static_cast<size_t>(i)] - p.corners[static_cast<size_t>(j)]));
+  return d;
+}
+
+double signed_area(const std::vector<dvec2>& polygon) {
+  double a = 0.0;
+  for (size_t i = 0; i < polygon.size(); ++i) a += cross2(polygon[i], polygon[(i + 1) % polygon.size()]);
+  return 0.5 * a;
+}
+
+std::vector<dvec2> points_of(const Polygon2& piece) {
+  std::vector<dvec2> out;
+  for (const Vertex& v : piece) out.push_back(v.p);
+  return out;
+}
+
+dvec2 centroid_of(const std::vector<dvec2>& polygon) {
+  dvec2 c(0.0);
+  double area = 0.0;
+  for (size_t i = 0; i < polygon.size(); ++i) {
+    const dvec2& a = polygon[i];
+    const dvec2& b = polygon[(i + 1) % polygon.size()];
+    const double w = cross2(a, b);
+    c += w * (a + b);
+    area += w;
+  }
+  return std::abs(area) > 0.0 ? c / (3.0 * area) : polygon[0];
+}
+
+bool inside(const std::vector<dvec2>& ccw, const dvec2& q, double tolerance) {
+  for (size_t i = 0; i < ccw.size(); ++i) {
+    const dvec2 e = ccw[(i + 1) % ccw.size()] - ccw[i];
+    if (cross2(e, q - ccw[i]) < -tolerance * glm::length(e)) return false;
+  }
+  return true;
+}
+
+struct Segment {
+  dvec2 a{0.0}, b{0.0};
+};
+
+// Length of the part of `s` inside the convex piece.
+double length_inside(const Polygon2& piece, const Segment& s) {
+  const dvec2 d = s.b - s.a;
+  double t0 = 0.0, t1 = 1.0;
+  for (size_t i = 0; i < piece.size(); ++i) {
+    const dvec2& p = piece[i].p;
+    const dvec2 e = piece[(i + 1) % piece.size()].p - p;
+    const double num = cross2(e, s.a - p), den = cross2(e, d);  // inside: num + t den >= 0
+    if (std::abs(den) <= 1e-15 * glm::length(e) * glm::length(d)) {
+      if (num < 0.0) return 0.0;
+      continue;
+    }
+    const double t = -num / den;
+    if (den > 0.0) t0 = std::max(t0, t);
+    else t1 = std::min(t1, t);
+    if (t0 >= t1) return 0.0;
+  }
+  return (t1 - t0) * glm::length(d);
+}
+
+// Splits a convex piece along the line of `s`. False (no split) when either
+// side would be thinner than `thinnest` across the line.
+bool split(const Polygon2& piece, const Segment& s, double thinnest, Polygon2& left, Polygon2& right) {
+  const dvec2 d = glm::normalize(s.b - s.a);
+  const double on_line = 1e-3 * thinnest;
+  std::vector<double> distance(piece.size());
+  double most_left = 0.0, most_right = 0.0;
+  for (size_t i = 0; i < piece.size(); ++i) {
+    distance[i] = cross2(d, piece[i].p - s.a);
+    most_left = std::max(most_left, distance[i]);
+    most_right = std::max(most_right, -distance[i]);
+  }
+  if (most_left < thinnest || most_right < thinnest) return false;
+  left.clear();
+  right.clear();
+  for (size_t i = 0; i < piece.size(); ++i) {
+    const size_t j = (i + 1) % piece.size();
+    const double di = distance[i], dj = distance[j];
+    if (di >= -on_line) left.push_back(piece[i]);
+    if (di <= on_line) right.push_back(piece[i]);
+    if ((di > on_line && dj < -on_line) || (di < -on_line && dj > on_line)) {
+      const double t = di / (di - dj);
+      const Vertex v{piece[i].p + t * (piece[j].p - piece[i].p), piece[i].x + t * (piece[j].x - piece[i].x)};
+      left.push_back(v);
+      right.push_back(v);
+    }
+  }
+  return left.size() >= 3 && right.size() >= 3;
+}
+
+// What of patch Q touches patch P: cut segments in P's frame, and, where Q
+// lies in P's plane, Q's outline there (for merging coinciding pieces).
+struct Contact {
+  std::vector<Segment> cuts;
+  std::vector<dvec2> coincident_outline;  // counter-clockwise; empty if Q does not lie in P's plane
+};
+
+Contact contact_of(const Frame& f, double dp, const Patch& q, double dq, double scene_diameter) {
+  Contact out;
+  double s[4];
+  double nearest = std::numeric_limits<double>::infinity(), farthest = 0.0, lo = 0.0, hi = 0.0;
+  for (int i = 0; i < q.corner_count; ++i) {
+    s[i] = glm::dot(f.n, q.corners[static_cast<size_t>(i)] - f.origin);
+    nearest = std::min(nearest, std::abs(s[i]));
+    farthest = std::max(farthest, std::abs(s[i]));
+    lo = std::min(lo, s[i]);
+    hi = std::max(hi, s[i]);
+  }
+  const double touch = std::max(kCoincident * std::max(dp, dq), kCoincidentScene * scene_diameter);
+  if (std::abs(glm::dot(f.n, q.normal)) >= kParallelCosine) {
+    if (farthest > kCoverGap * std::min(dp, dq)) return out;
+    std::vector<dvec2> outline;
+    for (int i = 0; i < q.corner_count; ++i) outline.push_back(f.to2(q.corners[static_cast<size_t>(i)]));
+    if (signed_area(outline) < 0.0) std::reverse(outline.begin(), outline.end());
+    for (size_t i = 0; i < outline.size(); ++i) out.cuts.push_back({outline[i], outline[(i + 1) % outline.size()]});
+    if (farthest <= touch) out.coincident_outline = std::move(outline);
+    return out;
+  }
+  // Where Q meets P's plane: the segment it crosses it along, or the edge
+  // that rests on it.
+  std::vector<dvec3> points;
+  if (lo < -touch && hi > touch) {
+    for (int i = 0; i < q.corner_count; ++i) {
+      const int j = (i + 1) % q.corner_count;
+      const dvec3& a = q.corners[static_cast<size_t>(i)];
+      const dvec3& b = q.corners[static_cast<size_t>(j)];
+      if (std::abs(s[i]) <= touch) points.push_back(a);
+      else if ((s[i] > touch && s[j] < -touch) || (s[i] < -touch && s[j] > touch))
+        points.push_back(a + (s[i] / (s[i] - s[j])) * (b - a));
+    }
+  } else {
+    const double foot = std::max(touch, kFootGap * dq);
+    if (nearest > foot) return out;
+    for (int i = 0; i < q.corner_count; ++i)
+      if (std::abs(s[i]) <= foot) points.push_back(q.corners[static_cast<size_t>(i)]);
+  }
+  if (points.size() < 2) return out;
+  size_t a = 0, b = 1;
+  double best = -1.0;
+  for (size_t i = 0; i < points.size(); ++i)
+    for (size_t j = i + 1; j < points.size(); ++j) {
+      const double d = glm::length(points[i] - points[j]);
+      if (d > best) best = d, a = i, b = j;
+    }
+  out.cuts.push_back({f.to2(points[a]), f.to2(points[b])});
+  return out;
+}
+
+// A piece of a patch as it is cut, and what becomes of it.
+struct Piece {
+  Polygon2 polygon;
+  std::array<PatchSide, 2> sides{};
+  std::vector<std::uint32_t> coincides_with;  // patches whose outline it lies in, in its plane
+  std::int64_t merged_into = -1;              // index in the flat piece list
+  dvec3 centre{0.0};
+  double area = 0.0;
+};
+
+// The convex polygon as triangles and quads, dropping corners that lie on
+// the line of their neighbours (a cut that ended on an edge).
+void append_patches(const Patch& source, const Piece& piece, std::vector<Patch>& out) {
+  std::vector<dvec3> corners;
+  const Polygon2& poly = piece.polygon;
+  const double scale = std::sqrt(piece.area);
+  for (size_t i = 0; i < poly.size(); ++i) {
+    const dvec2& prev = poly[(i + poly.size() - 1) % poly.size()].p;
+    const dvec2& here = poly[i].p;
+    const dvec2& next = poly[(i + 1) % poly.size()].p;
+    if (glm::length(here - prev) <= 1e-9 * scale) continue;
+    if (cross2(here - prev, next - here) <= 1e-9 * glm::length(here - prev) * glm::length(next - here)) continue;
+    corners.push_back(poly[i].x);
+  }
+  const auto emit = [&](std::initializer_list<size_t> index) {
+    Patch p = source;
+    p.corner_count = static_cast<std::uint8_t>(index.size());
+    size_t k = 0;
+    for (size_t i : index) p.corners[k++] = corners[i];
+    dvec3 area_normal(0.0);
+    for (size_t i = 1; i + 1 < k; ++i) area_normal += glm::cross(p.corners[i] - p.corners[0], p.corners[i + 1] - p.corners[0]);
+    p.area = 0.5 * glm::length(area_normal);
+    p.sides = piece.sides;
+    if (p.area > 0.0) out.push_back(p);
+  };
+  const size_t n = corners.size();
+  if (n < 3) return;
+  size_t i = 1;
+  for (; i + 2 < n; i += 2) emit({0, i, i + 1, i + 2});
+  if (i + 1 < n) emit({0, i, i + 1});
+}
+
+}  // namespace
+
+void mesh_contacts(Scene& scene) {
+  std::vector<Patch>& patches = scene.patches;
+  const size_t n = patches.size();
+  if (n < 2) {
+    scene.occluders = patches;
+    return;
+  }
+  std::vector<Triangle> triangles;
+  std::vector<std::uint32_t> owner;
+  for (std::uint32_t p = 0; p < n; ++p) {
+    const Patch& patch = patches[p];
+    triangles.push_back({{patch.corners[0], patch.corners[1], patch.corners[2]}});
+    owner.push_back(p);
+    if (patch.corner_count == 4) {
+      triangles.push_back({{patch.corners[0], patch.corners[2], patch.corners[3]}});
+      owner.push_back(p);
+    }
+  }
+  const SceneBvh bvh = build_scene_bvh(triangles);
+  std::vector<double> diameter(n);
+  for (size_t p = 0; p < n; ++p) diameter[p] = diameter_of(patches[p]);
+
+  // Each patch cut on its own, in parallel: deterministic.
+  std::vector<std::vector<Piece>> cut(n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const auto& range) {
+    std::vector<std::uint32_t> near;
+    for (size_t p = range.begin(); p != range.end(); ++p) {
+      const Patch& patch = patches[p];
+      const Frame f = frame_of(patch);
+      Aabb box;
+      for (int k = 0; k < patch.corner_count; ++k) box.grow(patch.corners[static_cast<size_t>(k)]);
+      const dvec3 margin(kCoverGap * diameter[p] + kCoincidentScene * scene.diameter);
+      box.lo -= margin;
+      box.hi += margin;
+      near.clear();
+      traverse_scene_bvh(
+          bvh,
+          [&](const Aabb& b) {
+            return b.lo.x <= box.hi.x && b.hi.x >= box.lo.x && b.lo.y <= box.hi.y && b.hi.y >= box.lo.y &&
+                   b.lo.z <= box.hi.z && b.hi.z >= box.lo.z;
+          },
+          [&](std::uint32_t t) {
+            const std::uint32_t q = owner[t];
+            if (q != p && patches[q].surface != patch.surface) near.push_back(q);
+          });
+      std::sort(near.begin(), near.end());
+      near.erase(std::unique(near.begin(), near.end()), near.end());
+
+      std::vector<Segment> cuts;
+      std::vector<std::pair<std::uint32_t, std::vector<dvec2>>> coincident;
+      for (std::uint32_t q : near) {
+        Contact c = contact_of(f, diameter[p], patches[q], diameter[q], scene.diameter);
+        cuts.insert(cuts.end(), c.cuts.begin(), c.cuts.end());
+        if (!c.coincident_outline.empty()) coincident.emplace_back(q, std::move(c.coincident_outline));
+      }
+      Polygon2 whole;
+      for (int k = 0; k < patch.corner_count; ++k)
+        whole.push_back({f.to2(patch.corners[static_cast<size_t>(k)]), patch.corners[static_cast<size_t>(k)]});
+      std::vector<Polygon2> pieces{whole};
+      const double thinnest = kThinnest * diameter[p];
+      Polygon2 left, right;
+      for (const Segment& s : cuts) {
+        if (!(glm::length(s.b - s.a) > thinnest)) continue;
+        std::vector<Polygon2> next;
+        for (const Polygon2& piece : pieces) {
+          if (length_inside(piece, s) > thinnest && split(piece, s, thinnest, left, right)) {
+            next.push_back(left);
+            next.push_back(right);
+          } else {
+            next.push_back(piece);
+          }
+        }
+        pieces = std::move(next);
+      }
+      for (Polygon2& polygon : pieces) {
+        Piece piece;
+        const std::vector<dvec2> points = points_of(polygon);
+        piece.area = std::abs(signed_area(points));
+        const dvec2 c = centroid_of(points);
+        piece.centre = f.origin + c.x * f.u + c.y * f.v;
+        for (const auto& [q, outline] : coincident)
+          if (inside(outline, c, thinnest)) piece.coincides_with.push_back(q);
+        piece.polygon = std::move(polygon);
+        piece.sides = patch.sides;
+        cut[p].push_back(std::move(piece));
+      }
+    }
+  });
+
+  // Coinciding pieces: the later patch's piece goes into the earlier's.
+  std::vector<size_t> first_piece(n + 1, 0);
+  for (size_t p = 0; p < n; ++p) first_piece[p + 1] = first_piece[p] + cut[p].size();
+  std::vector<Piece*> flat;
+  for (auto& pieces : cut)
+    for (Piece& piece : pieces) flat.push_back(&piece);
+  const auto resolve = [&](std::int64_t index) {
+    while (flat[static_cast<size_t>(index)]->merged_into >= 0) index = flat[static_cast<size_t>(index)]->merged_into;
+    return index;
+  };
+  std::vector<std::array<std::uint32_t, 2>> coincident;
+  for (size_t p = 0; p < n; ++p) {
+    for (size_t k = 0; k < cut[p].size(); ++k) {
+      Piece& piece = cut[p][k];
+      std::int64_t target = -1;
+      for (std::uint32_t q : piece.coincides_with) {
+        if (q >= p) break;  // sorted: only earlier patches
+        const double tolerance = kThinnest * std::max(diameter[p], diameter[q]);
+        for (size_t m = 0; m < cut[q].size() && target < 0; ++m) {
+          const Piece& other = cut[q][m];
+          if (glm::length(other.centre - piece.centre) <= tolerance &&
+              std::abs(other.area - piece.area) <= 1e-3 * std::max(other.area, piece.area))
+            target = static_cast<std::int64_t>(first_piece[q] + m);
+        }
+        if (target >= 0) {
+          coincident.push_back({std::min(patches[p].sides[0].face, patches[q].sides[0].face),
+                                std::max(patches[p].sides[0].face, patches[q].sides[0].face)});
+          break;
+        }
+      }
+      if (target < 0) continue;
+      target = resolve(target);
+      Piece& into = *flat[static_cast<size_t>(target)];
+      size_t owner_patch = 0;
+      while (first_piece[owner_patch + 1] <= static_cast<size_t>(target)) ++owner_patch;
+      const bool same_facing = glm::dot(patches[p].normal, patches[owner_patch].normal) > 0.0;
+      for (size_t s = 0; s < 2; ++s) {
+        const PatchSide& side = piece.sides[s];
+        if (!side.present) continue;
+        PatchSide& there = into.sides[same_facing ? s : 1 - s];
+        const bool emits = luminance(side.emission) > 0.0, there_emits = luminance(there.emission) > 0.0;
+        if (!there.present || (emits && !there_emits)) there = side;
+      }
+      piece.merged_into = target;
+    }
+  }
+  std::sort(coincident.begin(), coincident.end());
+  coincident.erase(std::unique(coincident.begin(), coincident.end()), coincident.end());
+  scene.coincident = std::move(coincident);
+
+  scene.occluders.clear();
+  for (size_t p = 0; p < n; ++p) {
+    const bool merged = std::all_of(cut[p].begin(), cut[p].end(), [](const Piece& piece) { return piece.merged_into >= 0; });
+    if (!merged) scene.occluders.push_back(patches[p]);
+  }
+  std::vector<Patch> out;
+  out.reserve(n);
+  scene.split_faces = 0;
+  std::vector<std::uint32_t> split_surfaces;
+  for (size_t p = 0; p < n; ++p) {
+    if (cut[p].size() == 1 && cut[p][0].merged_into < 0) {
+      Patch whole = patches[p];
+      whole.sides = cut[p][0].sides;
+      out.push_back(whole);
+      continue;
+    }
+    if (cut[p].size() > 1) split_surfaces.push_back(patches[p].surface);
+    for (const Piece& piece : cut[p])
+      if (piece.merged_into < 0) append_patches(patches[p], piece, out);
+  }
+  std::sort(split_surfaces.begin(), split_surfaces.end());
+  scene.split_faces = static_cast<size_t>(std::unique(split_surfaces.begin(), split_surfaces.end()) - split_surfaces.begin());
+  patches = std::move(out);
+}
+
+}  // namespace radiosity
