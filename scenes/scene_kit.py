@@ -131,6 +131,23 @@ def diffuse_material(name, color):
     return mat
 
 
+def lambertian_material(name, color):
+    """A Lambertian material: a Diffuse BSDF of `color` (linear RGB), the surface
+    radiosity models exactly (the Principled BSDF's diffuse is not Lambertian).
+    The Diffuse BSDF node and its Color input are the same in Blender 3.x to 5.x."""
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    nodes.clear()
+    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
+    bsdf.inputs["Color"].default_value = (*color, 1.0)
+    output = nodes.new("ShaderNodeOutputMaterial")
+    output.location = (300, 0)
+    links.new(bsdf.outputs["BSDF"], output.inputs["Surface"])
+    mat.diffuse_color = (*color, 1.0)
+    return mat
+
+
 def emission_material(name, strength, color=(1.0, 1.0, 1.0)):
     """A light: an Emission shader of radiance color x strength, nothing else."""
     mat = bpy.data.materials.new(name)
