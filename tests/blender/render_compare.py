@@ -18,11 +18,15 @@ import numpy as np
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 
 
-def render_image(scene, samples, resolution=(96, 72)):
-    """Render `scene` with Cycles; (H, W, 3) linear float image."""
+def render_image(scene, samples, resolution=(96, 72), seed=None):
+    """Render `scene` with Cycles; (H, W, 3) linear float image. `seed`: Cycles'
+    sampling seed (default: the scene's)."""
     scene.render.engine = 'CYCLES'
     scene.cycles.device = 'CPU'
     scene.cycles.samples = samples
+    if seed is not None:
+        scene.cycles.seed = seed
+        scene.cycles.use_animated_seed = False
     scene.cycles.use_denoising = False
     scene.cycles.use_adaptive_sampling = False
     scene.render.resolution_x, scene.render.resolution_y = resolution

@@ -1,0 +1,209 @@
+"""How issue 12 measures a radiosity solution against a path trace (inside Blender):
+the cases, the cached path-traced reference and its noise, the emitter mask,
+and the two numbers of the acceptance. Used by tests/blender/test_contact.py
+and bench/contact_gap.py, so the test and the bench measure the same thing.
+
+- Images: 128 x 128 pixels from the scene's camera, Standard view transform,
+  linear radiance read back from OpenEXR (render_compare.render_image).
+- Emitter pixels are left out of every statistic: the pixels any emitter
+  covers, found by a render in which every other object is a holdout (black,
+  but still hiding what is behind it), widened by one pixel for the pixel
+  filter's reach (an emitter at 20 times a wall's radiance spreads into its
+  neighbours). The emitter itself is exact in both renders; its pixels would
+  only dilute the error.
+- Exposure error: mean linear Rec. 709 luminance (not clipped) of the
+  solution's render over the reference's, minus 1 (signed: > 0 is too bright).
+- Block error: the image cut into 8 x 8-pixel blocks; per block the relative
+  difference of the mean luminances, relative to the reference block floored
+  at a tenth of the image mean (black blocks are judged in absolute terms);
+  blocks more than half emitter are left out; the median over blocks.
+- Reference: the original scene path traced (32 bounces, no clamping) with two
+  seeds; it is their mean, and their difference measures its noise (the mean
+  of two renders carries half their difference). Cached as .npy under
+  <build>/contact_cache, keyed by the case's scene and parameters, the image
+  size, the samples, the seed, the Blender version and the source of the
+  scene builders, so a second run renders nothing.
+"""
+
+import hashlib
+import json
+import os
+import pathlib
+import sys
+
+import bpy
+import numpy as np
+
+import render_compare as rc
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "scenes"))
+import build_scene  # noqa: E402
+import scene_kit  # noqa: E402
+
+RESOLUTION = (128, 128)
+BLOCK = 8
+# Per seed, two seeds: the reference's median block noise is then 0.2-0.5 %
+# (measured, see test_contact.py), well below the 6 % block tolerance.
+REFERENCE_SAMPLES = 128
+SEEDS = (1, 2)
+MASK_SAMPLES = 16
+# The solution has no noise of its own (emission only): samples anti-alias.
+SOLUTION_SAMPLES = 8
+ORACLES = ("STANDARD", "PERCEPTUAL", "GRADIENT")
+QUALITIES = (0.3, 0.5, 0.8)
+
+# label: (scene, builder parameters)
+CASES = {
+    "cornell_box": ("cornell_box", {}),    # as published: the light 0.1 mm under the ceiling
+    "cornell_box_1mm": ("cornell_box", {"gap": 1e-3}),
+    "cornell_box_1cm": ("cornell_box", {"gap": 1e-2}),
+    "cornell_box_5cm": ("cornell_box", {"gap": 5e-2}),
+    "box_on_floor": ("box_on_floor", {}),
+    "lamp_on_table": ("lamp_on_table", {}),
+    "picture_on_wall": ("picture_on_wall", {}),
+}
+GAPS = (("0.1 mm", "cornell_box"), ("1 mm", "cornell_box_1mm"), ("1 cm", "cornell_box_1cm"),
+        ("5 cm", "cornell_box_5cm"))
+# Bump when the way references are rendered changes, to drop old cache entries.
+RENDER_VERSION = 1
+
+
+def build_dir():
+    """The build tree this Blender loaded the add-on from (<build>/addon/radiosity)."""
+    import radiosity
+    return pathlib.Path(radiosity.__file__).resolve().parents[2]
+
+
+def build_case(label):
+    """A fresh file holding only the case's scene; returns the scene."""
+    name, params = CASES[label]
+    scene = scene_kit.empty_file()
+    scene.name = label
+    build_scene.build(name, scene, **params)
+    scene.view_layers[0].update()
+    return scene
+
+
+def cache_key(label, samples, seed):
+    name, params = CASES[label]
+    h = hashlib.sha256()
+    for source in ("scene_kit.py", "build_scene.py", name + ".py"):
+        h.update((ROOT / "scenes" / source).read_bytes())
+    h.update(json.dumps([name, sorted(params.items()), RESOLUTION, samples, seed, bpy.app.version_string,
+                         RENDER_VERSION]).encode())
+    return "%s_%s" % (label, h.hexdigest()[:16])
+
+
+def _cached(path, render):
+    if path.exists():
+        return np.load(path), True
+    image = render()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    np.save(path, image)
+    return image, False
+
+
+def emitter_objects(scene):
+    """Objects that emit: area lights and meshes with an emitting material (as the add-on reads them)."""
+    from radiosity import export
+    reader = export.MaterialReader()
+    out = []
+    for obj in scene.objects:
+        if obj.type == 'LIGHT':
+            out.append(obj)
+        elif obj.type == 'MESH' and any(reader.read(s.material)[1].max() > 0 for s in obj.material_slots):
+            out.append(obj)
+    return out
+
+
+def render_emitter_mask(scene):
+    """(H, W) bool: pixels an emitter covers or reaches through the pixel filter."""
+    emitters = set(emitter_objects(scene))
+    others = [o for o in scene.objects if o.type == 'MESH' and o not in emitters]
+    bounces = scene.cycles.max_bounces
+    for obj in others:
+        obj.is_holdout = True
+    scene.cycles.max_bounces = 0
+    try:
+        image = rc.render_image(scene, MASK_SAMPLES, RESOLUTION, seed=0)
+    finally:
+        for obj in others:
+            obj.is_holdout = False
+        scene.cycles.max_bounces = bounces
+    covered = image.max(axis=2) > 0.0
+    grown = covered.copy()   # one pixel wider in the 8 directions
+    grown[1:, :] |= covered[:-1, :]
+    grown[:-1, :] |= covered[1:, :]
+    grown[:, 1:] |= grown[:, :-1].copy()
+    grown[:, :-1] |= grown[:, 1:].copy()
+    return grown
+
+
+class Reference:
+    """The path-traced reference of a case: mean image, the seeds' images, the emitter mask."""
+
+    def __init__(self, label, scene, cache_dir=None):
+        cache_dir = pathlib.Path(cache_dir or build_dir() / "contact_cache")
+        self.seeds, self.rendered = [], 0
+        for seed in SEEDS:
+            image, hit = _cached(cache_dir / (cache_key(label, REFERENCE_SAMPLES, seed) + ".npy"),
+                                 lambda: rc.render_image(scene, REFERENCE_SAMPLES, RESOLUTION, seed=seed))
+            self.seeds.append(image)
+            self.rendered += not hit
+        self.image = np.mean(self.seeds, axis=0)
+        self.mask, hit = _cached(cache_dir / (cache_key(label, MASK_SAMPLES, "mask") + ".npy"),
+                                 lambda: render_emitter_mask(scene))
+        self.rendered += not hit
+
+    def noise(self):
+        """Errors the reference's own noise alone causes: half the two seeds' difference."""
+        a, b = self.seeds
+        e = compare(a, b, self.mask)
+        return dict(exposure=abs(e["exposure"]) / 2, block=e["block"] / 2)
+
+
+def luminance(image):
+    return np.asarray(image, dtype=np.float64) @ rc.LUMINANCE
+
+
+def block_means(lum, keep):
+    """Per 8 x 8 block: mean of the kept pixels, and the fraction kept."""
+    h, w = lum.shape
+    shape = (h // BLOCK, BLOCK, w // BLOCK, BLOCK)
+    kept = keep[:h // BLOCK * BLOCK, :w // BLOCK * BLOCK].reshape(shape).sum(axis=(1, 3))
+    total = np.where(keep, lum, 0.0)[:h // BLOCK * BLOCK, :w // BLOCK * BLOCK].reshape(shape).sum(axis=(1, 3))
+    return total / np.maximum(kept, 1), kept / BLOCK ** 2
+
+
+def compare(solution, reference, mask):
+    """dict(exposure: signed relative error of the mean luminance, block: median block error,
+    blocks: how many blocks were judged), emitter pixels (mask) left out."""
+    keep = ~np.asarray(mask, dtype=bool)
+    a, b = luminance(solution), luminance(reference)
+    mean_a, mean_b = a[keep].mean(), b[keep].mean()
+    ba, fraction = block_means(a, keep)
+    bb, _ = block_means(b, keep)
+    judged = fraction >= 0.5
+    error = np.abs(ba - bb) / np.maximum(bb, 0.1 * mean_b)
+    return dict(exposure=float(mean_a / mean_b - 1.0), block=float(np.median(error[judged])),
+                blocks=int(judged.sum()), mean=float(mean_a), reference_mean=float(mean_b))
+
+
+def solve_and_render(scene, oracle, quality):
+    """Solve at the default settings but oracle and quality; (render of the solution, stats)."""
+    scene.radiosity.oracle = oracle
+    scene.radiosity.quality = quality
+    if bpy.ops.radiosity.solve() != {'FINISHED'}:
+        raise RuntimeError("solve of %s (%s, %.1f) did not finish" % (scene.name, oracle, quality))
+    return rc.render_image(scene, SOLUTION_SAMPLES, RESOLUTION, seed=0), scene.radiosity.stats
+
+
+def save_pngs(folder, label, reference, solutions):
+    """reference and {tag: image} as sRGB PNGs in `folder` (for looking at them)."""
+    os.makedirs(folder, exist_ok=True)
+    rc.save_png(reference.image, os.path.join(folder, label + "_cycles.png"))
+    mask = np.repeat(reference.mask[:, :, None], 3, axis=2)
+    rc.save_png(np.where(mask, [1.0, 0.0, 1.0], reference.image), os.path.join(folder, label + "_mask.png"))
+    for tag, image in solutions.items():
+        rc.save_png(image, os.path.join(folder, "%s_%s.png" % (label, tag)))
