@@ -5,18 +5,8 @@ and bench/contact_gap.py, so the test and the bench measure the same thing.
 
 - Images: 128 x 128 pixels from the scene's camera, Standard view transform,
   linear radiance read back from OpenEXR (render_compare.render_image).
-- Emitter pixels are left out of every statistic: the pixels any emitter
-  covers, found by a render in which every other object is a holdout (black,
-  but still hiding what is behind it), widened by one pixel for the pixel
-  filter's reach (an emitter at 20 times a wall's radiance spreads into its
-  neighbours). The emitter itself is exact in both renders; its pixels would
-  only dilute the error.
-- Exposure error: mean linear Rec. 709 luminance (not clipped) of the
-  solution's render over the reference's, minus 1 (signed: > 0 is too bright).
-- Block error: the image cut into 8 x 8-pixel blocks; per block the relative
-  difference of the mean luminances, relative to the reference block floored
-  at a tenth of the image mean (black blocks are judged in absolute terms);
-  blocks more than half emitter are left out; the median over blocks.
+- Emitter pixels are left out of every statistic (render_compare.emitter_mask).
+- Exposure error and median block error: image_agreement.compare.
 - Reference: the original scene path traced (32 bounces, no clamping) with two
   seeds; it is their mean, and their difference measures its noise (the mean
   of two renders carries half their difference). Cached as .npy under
@@ -34,6 +24,7 @@ import sys
 import bpy
 import numpy as np
 
+import image_agreement
 import render_compare as rc
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -42,7 +33,6 @@ import build_scene  # noqa: E402
 import scene_kit  # noqa: E402
 
 RESOLUTION = (128, 128)
-BLOCK = 8
 # Per seed, two seeds: the reference's median block noise is then 0.2-0.5 %
 # (measured, see test_contact.py), well below the 6 % block tolerance.
 REFERENCE_SAMPLES = 128
@@ -104,44 +94,9 @@ def _cached(path, render):
     return image, False
 
 
-def emitter_objects(scene):
-    """Objects that emit: area lights and meshes with an emitting material (as the add-on reads them)."""
-    from radiosity import export
-    reader = export.MaterialReader()
-    out = []
-    for obj in scene.objects:
-        if obj.type == 'LIGHT':
-            out.append(obj)
-        elif obj.type == 'MESH' and any(reader.read(s.material)[1].max() > 0 for s in obj.material_slots):
-            out.append(obj)
-    return out
-
-
-def render_emitter_mask(scene):
-    """(H, W) bool: pixels an emitter covers or reaches through the pixel filter."""
-    emitters = set(emitter_objects(scene))
-    others = [o for o in scene.objects if o.type == 'MESH' and o not in emitters]
-    bounces = scene.cycles.max_bounces
-    for obj in others:
-        obj.is_holdout = True
-    scene.cycles.max_bounces = 0
-    try:
-        image = rc.render_image(scene, MASK_SAMPLES, RESOLUTION, seed=0)
-    finally:
-        for obj in others:
-            obj.is_holdout = False
-        scene.cycles.max_bounces = bounces
-    covered = image.max(axis=2) > 0.0
-    grown = covered.copy()   # one pixel wider in the 8 directions
-    grown[1:, :] |= covered[:-1, :]
-    grown[:-1, :] |= covered[1:, :]
-    grown[:, 1:] |= grown[:, :-1].copy()
-    grown[:, :-1] |= grown[:, 1:].copy()
-    return grown
-
-
 class Reference:
-    """The path-traced reference of a case: mean image, the seeds' images, the emitter mask."""
+    """The path-traced reference of a case: mean image, the seeds' images, the
+    emitter mask; `rendered` counts what was not in the cache."""
 
     def __init__(self, label, scene, cache_dir=None):
         cache_dir = pathlib.Path(cache_dir or build_dir() / "contact_cache")
@@ -153,41 +108,14 @@ class Reference:
             self.rendered += not hit
         self.image = np.mean(self.seeds, axis=0)
         self.mask, hit = _cached(cache_dir / (cache_key(label, MASK_SAMPLES, "mask") + ".npy"),
-                                 lambda: render_emitter_mask(scene))
+                                 lambda: rc.emitter_mask(scene, MASK_SAMPLES, RESOLUTION))
         self.rendered += not hit
 
     def noise(self):
         """Errors the reference's own noise alone causes: half the two seeds' difference."""
         a, b = self.seeds
-        e = compare(a, b, self.mask)
+        e = image_agreement.compare(a, b, self.mask)
         return dict(exposure=abs(e["exposure"]) / 2, block=e["block"] / 2)
-
-
-def luminance(image):
-    return np.asarray(image, dtype=np.float64) @ rc.LUMINANCE
-
-
-def block_means(lum, keep):
-    """Per 8 x 8 block: mean of the kept pixels, and the fraction kept."""
-    h, w = lum.shape
-    shape = (h // BLOCK, BLOCK, w // BLOCK, BLOCK)
-    kept = keep[:h // BLOCK * BLOCK, :w // BLOCK * BLOCK].reshape(shape).sum(axis=(1, 3))
-    total = np.where(keep, lum, 0.0)[:h // BLOCK * BLOCK, :w // BLOCK * BLOCK].reshape(shape).sum(axis=(1, 3))
-    return total / np.maximum(kept, 1), kept / BLOCK ** 2
-
-
-def compare(solution, reference, mask):
-    """dict(exposure: signed relative error of the mean luminance, block: median block error,
-    blocks: how many blocks were judged), emitter pixels (mask) left out."""
-    keep = ~np.asarray(mask, dtype=bool)
-    a, b = luminance(solution), luminance(reference)
-    mean_a, mean_b = a[keep].mean(), b[keep].mean()
-    ba, fraction = block_means(a, keep)
-    bb, _ = block_means(b, keep)
-    judged = fraction >= 0.5
-    error = np.abs(ba - bb) / np.maximum(bb, 0.1 * mean_b)
-    return dict(exposure=float(mean_a / mean_b - 1.0), block=float(np.median(error[judged])),
-                blocks=int(judged.sum()), mean=float(mean_a), reference_mean=float(mean_b))
 
 
 def solve_and_render(scene, oracle, quality):

@@ -8,7 +8,8 @@ wall. For each oracle at qualities 0.3, 0.5 and 0.8, solved at the default
 settings otherwise, the baked solution rendered from the scene's camera must
 match a path trace of the original scene: mean linear luminance within 3 %
 (signed "exposure" error) and the median 8 x 8-pixel-block relative error
-within 6 %, emitter pixels left out (contact_agreement.py says how).
+within 6 %, emitter pixels left out (image_agreement.py and
+render_compare.emitter_mask say how).
 
 The path-traced reference (2 seeds x 128 samples, 128 x 128 pixels) is cached
 under <build>/contact_cache, so only the first run renders it; its own noise
@@ -25,6 +26,7 @@ import os
 import unittest
 
 import contact_agreement as ca
+import image_agreement
 
 MEAN_TOLERANCE = 0.03
 BLOCK_TOLERANCE = 0.06
@@ -48,7 +50,7 @@ class ContactAgreementTest(unittest.TestCase):
             for quality in ca.QUALITIES:
                 image, stats = ca.solve_and_render(scene, oracle, quality)
                 renders["%s_%.1f" % (oracle.lower(), quality)] = image
-                e = ca.compare(image, reference.image, reference.mask)
+                e = image_agreement.compare(image, reference.image, reference.mask)
                 print("[agreement] %s %-10s q=%.1f: exposure %+6.1f %%, median block error %5.1f %% "
                       "(%d blocks; %d elements, %s)" % (label, oracle.lower(), quality, 100 * e["exposure"],
                                                         100 * e["block"], e["blocks"], stats.elements, stats.status),
