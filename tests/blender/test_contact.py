@@ -55,9 +55,12 @@ class ContactAgreementTest(unittest.TestCase):
                       "(%d blocks; %d elements, %s)" % (label, oracle.lower(), quality, 100 * e["exposure"],
                                                         100 * e["block"], e["blocks"], stats.elements, stats.status),
                       flush=True)
+                numbers = "%s %s q=%.1f: exposure %+.1f %% (tolerance %.0f %%), median block error %.1f %% " \
+                          "(tolerance %.0f %%)" % (label, oracle.lower(), quality, 100 * e["exposure"],
+                                                   100 * MEAN_TOLERANCE, 100 * e["block"], 100 * BLOCK_TOLERANCE)
                 with self.subTest(oracle=oracle, quality=quality):
-                    self.assertLess(abs(e["exposure"]), MEAN_TOLERANCE)
-                    self.assertLess(e["block"], BLOCK_TOLERANCE)
+                    self.assertLess(abs(e["exposure"]), MEAN_TOLERANCE, numbers)
+                    self.assertLess(e["block"], BLOCK_TOLERANCE, numbers)
         folder = os.environ.get("RADIOSITY_TEST_IMAGES")
         if folder:
             ca.save_pngs(folder, label, reference, renders)
