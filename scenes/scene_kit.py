@@ -3,8 +3,9 @@
 Geometry is built from numpy arrays of quads with outward (for objects) or
 inward (for rooms) normals, so every face's front side is the side that sees
 the rest of the scene. Materials are plain: Principled BSDF with a base colour
-and no specular layer (a diffuse surface, the scenes radiosity models), and an
-Emission shader for lights. Render settings make a Cycles render of the scene a
+and no specular layer (a diffuse surface, the scenes radiosity models), or a
+Diffuse BSDF where a scene is built Lambertian from the start (the Cornell box,
+the contact scenes), and an Emission shader for lights. Render settings make a Cycles render of the scene a
 reference for the radiosity solution: CPU, Standard view transform, enough
 diffuse bounces, no clamping.
 """
