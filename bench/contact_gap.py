@@ -53,7 +53,7 @@ def main():
     for label in dict.fromkeys(gap_cases + matrix_cases):
         scene = ca.build_case(label)
         reference = ca.Reference(label, scene)
-        noise[label] = (reference.noise(), reference.rendered)
+        noise[label] = (reference.noise(), len(reference.seeds), reference.rendered)
         renders = {}
         for oracle in ca.ORACLES:
             for quality in (qualities if label in matrix_cases else (0.5,)):
@@ -78,7 +78,7 @@ def main():
                  for o in ca.ORACLES]
         print("| %s | %s |" % (gap, " | ".join(cells)))
 
-    print("\nAcceptance (test_contact.py: |exposure| < 3 %%, median block error < 6 %%): "
+    print("\nAcceptance (test_contact.py: |exposure| < 3 %, median block error < 6 %; x: outside): "
           "exposure error / median block error\n")
     header = ["%s %.1f" % (o, q) for o in names for q in qualities]
     print("| case | %s |" % " | ".join(header))
@@ -94,11 +94,11 @@ def main():
                 cells.append("%+.1f %% / %.1f %%%s" % (100 * r["exposure"], 100 * r["block"], "" if ok else " x"))
         print("| %s | %s |" % (label, " | ".join(cells)))
 
-    print("\nReferences (%d seeds x %d samples, %d x %d): their own noise, exposure / median block\n"
-          % (len(ca.SEEDS), ca.REFERENCE_SAMPLES, *ca.RESOLUTION))
-    for label, (n, rendered) in noise.items():
-        print("  %-16s %.3f %% / %.2f %%%s" % (label, 100 * n["exposure"], 100 * n["block"],
-                                             "" if rendered else " (cached)"))
+    print("\nReferences (%d x %d, seeds of %d samples): their own noise, exposure / median block\n"
+          % (*ca.RESOLUTION, ca.REFERENCE_SAMPLES))
+    for label, (n, seeds, rendered) in noise.items():
+        print("  %-16s %d seeds: %.3f %% / %.2f %%%s" % (label, seeds, 100 * n["exposure"], 100 * n["block"],
+                                                       "" if rendered else " (cached)"))
     print("\n%d of %d acceptance cases outside the tolerances; %.0f s" % (
         failed, len(matrix_cases) * len(ca.ORACLES) * len(qualities), time.perf_counter() - started), flush=True)
     radiosity.unregister()

@@ -36,9 +36,9 @@ WHITE = (0.7363, 0.7367, 0.7379)
 GREEN = (0.0677, 0.3989, 0.0862)
 RED = (0.4923, 0.0490, 0.0511)
 LIGHT_COLOUR = (1.675, 0.8777, 0.224)
-# Luminance of the light's radiance: chosen (not published) so that the walls
-# render at about 0.2-0.5 under the Standard view transform.
-LIGHT_STRENGTH = 18.0
+# Luminance of the light's radiance: chosen (not published) so that the back
+# wall renders at about 0.2-0.4 under the Standard view transform.
+LIGHT_STRENGTH = 30.0
 
 # Published vertex lists (mm), in their published order (each face counter-clockwise
 # seen from inside the box, or from outside a block).
