@@ -221,7 +221,7 @@ class ContactScenesTest(unittest.TestCase):
             self.assertTrue(np.all(np.einsum("ij,ij->i", normals, centres - middle) > 0), name)
             z = np.array([(obj.matrix_world @ v.co).z for v in obj.data.vertices])
             self.assertAlmostEqual(z.min(), 0.0, places=9)
-            self.assertAlmostEqual(z.max(), height, places=9)
+            self.assertAlmostEqual(z.max(), height, places=6)
         # The published left wall is not planar: its fourth corner is off the other three's plane.
         wall = objs["Wall.Left"]
         p = np.array([wall.matrix_world @ v.co for v in wall.data.vertices])
