@@ -5,7 +5,8 @@ path-traced reference, from the scene's camera, as linear EXR.
         --addon BUILD/addon --jobs JOBS.json
 
 JOBS.json: {"width", "height", "samples", "camera": OUT.json (optional),
-"solutions": [{"npz", "exr", "edges" (optional)}], "references": [{"exr", "samples", "seed"}]}.
+"mask": OUT.npy (optional), "solutions": [{"npz", "exr", "edges" (optional)}],
+"references": [{"exr", "samples", "seed"}]}.
 
 - A solution (arrays of a Result saved by the sweep) is baked into the scene by
   the add-on's own bake (result meshes emitting their radiance, originals
@@ -15,6 +16,8 @@ JOBS.json: {"width", "height", "samples", "camera": OUT.json (optional),
 - A reference is the original scene (Lambertian materials) path traced with the
   scene's bounce settings, at the given samples and seed.
 - "camera" receives the world -> pixel projection (blender_common.camera_projection).
+- "mask" receives the (H, W) bool array of the pixels the emitters cover
+  (tests/blender/render_compare.emitter_mask), left out of the exposure error.
 """
 
 import os
@@ -28,7 +31,9 @@ from mathutils import Vector
 from mathutils.bvhtree import BVHTree
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "tests", "blender"))
 import blender_common as common  # noqa: E402
+import render_compare  # noqa: E402  (the emitter mask the agreement tests use)
 
 # Each edge is cut into this many pieces, each kept if its midpoint is seen.
 EDGE_PIECES = 5
@@ -118,6 +123,8 @@ def main():
         common.render_to(scene, ref["exr"])
         common.say("reference %s: %d samples in %.1f s" % (os.path.basename(ref["exr"]), ref["samples"],
                                                            time.perf_counter() - start))
+    if jobs.get("mask"):
+        np.save(jobs["mask"], render_compare.emitter_mask(scene, resolution=(width, height)))
     if jobs.get("solutions"):
         common.setup_render(scene, width, height, jobs.get("samples", 16))
         exported = export.export_scene(bpy.context)

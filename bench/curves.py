@@ -1,6 +1,8 @@
 """The numbers read off the study's curves (no plotting here).
 
 - least_squares: the line y = a + b x and correlation r of Section 7.3.4.
+- value_at_cost: another quantity of a method's solves (the exposure error)
+  where its curve has a given cost, to state it beside an equal-error cost.
 - cost_at_error: how many elements (or seconds) a method needs to reach an
   error level. The measured error does not fall strictly monotonically with
   refinement (a finer mesh can move a shadow edge the wrong way), so the curve
@@ -60,6 +62,16 @@ def cost_to_reach(cost, error, level):
         return "<=", env[0][0]
     value = cost_at_error(cost, error, level)
     return ("=", value) if value is not None else (">", env[-1][0])
+
+
+def value_at_cost(cost, value, at):
+    """`value` of the solves interpolated linearly in log cost at cost `at` (the
+    end value outside the solves' range); None without solves or cost."""
+    cost, value = np.asarray(cost, dtype=float), np.asarray(value, dtype=float)
+    if at is None or len(cost) == 0:
+        return None
+    order = np.argsort(cost, kind="stable")
+    return float(np.interp(math.log(at), np.log(cost[order]), value[order]))
 
 
 def common_levels(curves, count=3):

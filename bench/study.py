@@ -28,8 +28,12 @@ HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(ROOT / "scenes"))
+sys.path.insert(0, str(ROOT / "tests" / "blender"))   # image_agreement (numpy only)
+
+import numpy as np  # noqa: E402
 
 import blender_jobs  # noqa: E402
+import image_agreement  # noqa: E402
 import study_config  # noqa: E402
 import sweep  # noqa: E402
 from build_all import build_scene  # noqa: E402
@@ -37,7 +41,7 @@ from build_all import build_scene  # noqa: E402
 CSV_FIELDS = ("scene", "method", "oracle", "quality", "threshold", "leaves", "elements", "links", "vertices",
               "seconds", "seconds_min", "repeats", "iterations", "passes", "peak_mb", "stopped_by",
               "cpu_visibility", "cpu_form_factors", "seconds_linking", "samples", "matched",
-              "dog_refined", "rms_refined", "dog_cycles", "rms_cycles", "image")
+              "dog_refined", "rms_refined", "dog_cycles", "rms_cycles", "exposure_cycles", "image")
 
 
 def log(message):
@@ -60,6 +64,7 @@ class SceneStudy:
         self.noise = None
         self.blend = self.dir / "scene.blend"
         self.arrays = self.dir / "arrays.npz"
+        self.mask_path = self.dir / "images" / "emitter_mask.npy"
 
     def solution_path(self, tag):
         return self.dir / "solutions" / ("%s.npz" % tag)
@@ -144,7 +149,8 @@ def render_all(rad, study, settings, blender, addon, cache_dir, verbose):
     start = time.perf_counter()
     blender_jobs.run_with_jobs(blender, study.blend, "blender_render.py", addon,
                                dict(width=s["width"], height=s["height"], samples=s["render_samples"],
-                                    camera=str(study.dir / "camera.json"), solutions=solutions),
+                                    camera=str(study.dir / "camera.json"), mask=str(study.mask_path),
+                                    solutions=solutions),
                                study.dir / "render_jobs.json", verbose)
     log("  %-11s rendered %d snapshots (%.0f s)" % (study.name, len(solutions), time.perf_counter() - start))
     start = time.perf_counter()
@@ -167,6 +173,14 @@ def render_all(rad, study, settings, blender, addon, cache_dir, verbose):
     log("  %-11s Cycles bakes: %d (%.0f s)" % (study.name, len(study.bake_rows), time.perf_counter() - start))
 
 
+def exposure(rad, study, exr, reference="cycles"):
+    """Signed exposure error of a snapshot against the path-traced reference:
+    mean linear luminance over the reference's, minus 1, emitter pixels left out
+    (tests/blender/image_agreement.py, the measure of the agreement tests)."""
+    return image_agreement.compare(rad.read_image(str(exr)), rad.read_image(str(study.image_path(reference))),
+                                   np.load(study.mask_path))["exposure"]
+
+
 def score_all(rad, study):
     refined = str(study.image_path("refined"))
     cycles = str(study.image_path("cycles"))
@@ -177,10 +191,19 @@ def score_all(rad, study):
         a = rad.image_errors(exr, refined, filtered_output=out)
         b = rad.image_errors(exr, cycles)
         row.update(dog_refined=a["dog"], rms_refined=a["rms"], dog_cycles=b["dog"], rms_cycles=b["rms"],
+                   exposure_cycles=exposure(rad, study, exr),
                    image=str(pathlib.Path(exr).relative_to(study.dir.parent.parent)))
     # The reference solution against the path-traced render: the floor of the Cycles curves.
-    study.refined_vs_cycles = rad.image_errors(refined, cycles)
+    study.refined_vs_cycles = dict(rad.image_errors(refined, cycles), exposure=exposure(rad, study, refined))
     rad.image_errors(cycles, refined, filtered_output=str(study.image_path("cycles_dog")))
+    # The reference's own exposure noise: its seeds differ by sqrt(2) times one
+    # render's noise, the mean of k seeds has 1/sqrt(k) of it (as references.py).
+    seeds = sorted(study.dir.joinpath("images").glob("cycles_seed*.exr"))
+    if len(seeds) >= 2:
+        d = exposure(rad, study, seeds[0], reference=seeds[1].stem)
+        study.noise["exposure"] = abs(d) / math.sqrt(2.0 * len(seeds))
+    else:
+        study.noise["exposure"] = float("nan")
 
 
 def write_csv(path, studies):

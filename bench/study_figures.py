@@ -23,11 +23,13 @@ def display(rgb):
 def comparison_figures(rad, studies, out):
     paths = []
     for st in studies:
-        rows = [("refined reference (%s, %d leaves)" % (st.reference[0], _refined(st)["leaves"]), "refined")]
+        rows = [("refined reference (%s, %d leaves), exposure %+.1f %%"
+                 % (st.reference[0], _refined(st)["leaves"], 100 * _refined(st)["exposure_cycles"]), "refined")]
         for oracle in study_config.ORACLES:
             r = st.comparison.get(oracle)
             if r is not None:
-                rows.append(("%s, %d leaves, DoG err %.2e" % (oracle, r["leaves"], r["dog_refined"]), r["tag"]))
+                rows.append(("%s, %d leaves, DoG err %.2e, exposure %+.1f %%"
+                             % (oracle, r["leaves"], r["dog_refined"], 100 * r["exposure_cycles"]), r["tag"]))
         rows.append(("Cycles path traced (%d x %d spp)" % (st.noise["seeds"], st.noise["samples_per_seed"]),
                      "cycles"))
         ref_dog = rad.read_image(str(st.image_path("refined_dog")))[:, :, 0]

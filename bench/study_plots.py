@@ -1,12 +1,14 @@
 """The study's plots (matplotlib, PNG): error against elements, time and vertices
 (Figures 48-49 of the source, for both references and both metrics, with the
-Cycles bake where it has the same axis), and elements against time with the
+Cycles bake where it has the same axis) and, beside them, the signed exposure
+error against the path-traced reference; and elements against time with the
 least-squares line of Section 7.3.4 (Figures 38-39)."""
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 import numpy as np  # noqa: E402
 
 import curves  # noqa: E402
@@ -15,6 +17,8 @@ import study_config  # noqa: E402
 COLOURS = {"standard": "tab:blue", "perceptual": "tab:orange", "gradient": "tab:green"}
 METRICS = (("dog_refined", "DoG error vs refined radiosity"), ("rms_refined", "plain RMS vs refined radiosity"),
            ("dog_cycles", "DoG error vs Cycles path traced"), ("rms_cycles", "plain RMS vs Cycles path traced"))
+# Signed, so on a linear axis beside the error metrics (which remove or dilute brightness).
+EXPOSURE = ("exposure_cycles", "exposure error vs Cycles (signed)")
 BAKE_MARKERS = "svD^P*"
 
 
@@ -23,10 +27,11 @@ def radiosity_rows(study, oracle):
 
 
 def _error_grid(studies, x_key, x_label, out_path, with_bake, title):
-    fig, axes = plt.subplots(len(studies), len(METRICS), figsize=(4.2 * len(METRICS), 3.4 * len(studies)),
+    columns = METRICS + (EXPOSURE,)
+    fig, axes = plt.subplots(len(studies), len(columns), figsize=(4.2 * len(columns), 3.4 * len(studies)),
                              squeeze=False)
     for i, st in enumerate(studies):
-        for j, (metric, label) in enumerate(METRICS):
+        for j, (metric, label) in enumerate(columns):
             ax = axes[i][j]
             for oracle in study_config.ORACLES:
                 rows = sorted(radiosity_rows(st, oracle), key=lambda r: r[x_key])
@@ -38,19 +43,29 @@ def _error_grid(studies, x_key, x_label, out_path, with_bake, title):
                     rows = sorted((b for b in st.bake_rows if b["samples"] == samples), key=lambda b: b[x_key])
                     ax.plot([b[x_key] for b in rows], [b[metric] for b in rows], "--", marker=BAKE_MARKERS[k % 6],
                             ms=4, lw=1, color=str(0.15 + 0.2 * k), label="Cycles bake %d spp" % samples)
+            kind = metric.split("_")[0]
             if metric.endswith("cycles") and st.noise:
-                ax.axhline(st.noise[metric.split("_")[0]], color="red", lw=0.8, ls=":",
-                           label="reference noise")
-                ax.axhline(st.refined_vs_cycles[metric.split("_")[0]], color="black", lw=0.8, ls="-.",
+                noise = st.noise[kind]
+                if metric == EXPOSURE[0]:
+                    ax.axhline(0.0, color="grey", lw=0.8)
+                    ax.axhspan(-noise, noise, color="red", alpha=0.15, label="reference noise")
+                else:
+                    ax.axhline(noise, color="red", lw=0.8, ls=":", label="reference noise")
+                ax.axhline(st.refined_vs_cycles[kind], color="black", lw=0.8, ls="-.",
                            label="refined radiosity")
             ax.set_xscale("log")
-            ax.set_yscale("log")
+            if metric == EXPOSURE[0]:
+                ax.yaxis.set_major_formatter(matplotlib.ticker.PercentFormatter(1.0))
+            else:
+                ax.set_yscale("log")
             ax.grid(True, which="both", alpha=0.3)
             ax.set_title("%s: %s" % (st.name, label), fontsize=9)
             ax.set_xlabel(x_label, fontsize=8)
             ax.tick_params(labelsize=7)
             if j == 0:
                 ax.set_ylabel("error (display brightness, 0-1)", fontsize=8)
+            if j == len(columns) - 1:
+                ax.set_ylabel("mean luminance / Cycles' - 1", fontsize=8)
             if i == 0 and j == len(METRICS) - 1:
                 ax.legend(fontsize=6, loc="best")
     fig.suptitle(title, fontsize=11)

@@ -1,8 +1,11 @@
 """report.md of the study: what was run, the references and their noise, the
 elements and time each oracle needs at equal error (interpolated along its
 curve, curves.py) with perceptual/standard ratios, the least-squares table of
-Section 7.3.4, and the Cycles bake comparison. Numbers only come from the rows
-measured in this run."""
+Section 7.3.4, and the Cycles bake comparison. Every table states the signed
+exposure error against the path-traced reference (mean linear luminance,
+emitter pixels left out) beside the error metrics, which do not see it: the
+DoG filter removes brightness, RMS on display brightness dilutes it. Numbers
+only come from the rows measured in this run."""
 
 import datetime
 import math
@@ -33,15 +36,17 @@ def bounded(pair):
     return fmt(value) if bound == "=" else "%s %s" % (bound, fmt(value))
 
 
-def exposure_ratio(st):
-    """Mean linear luminance (clipped at 1) of the refined snapshot over the Cycles one's."""
-    try:
-        import _radiosity as rad
-    except ImportError:
-        return None
-    lum = [np.clip(rad.brightness(rad.read_image(str(st.image_path(tag))), "linear"), 0, 1).mean()
-           for tag in ("refined", "cycles")]
-    return float(lum[0] / lum[1])
+def pct(v):
+    """A signed exposure error as per cent."""
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "-"
+    return "%+.1f %%" % (100 * v)
+
+
+def exposure_range(rows):
+    """'min .. max' of the rows' exposure errors."""
+    values = [r["exposure_cycles"] for r in rows]
+    return "%s .. %s" % (pct(min(values)), pct(max(values))) if values else "-"
 
 
 def ratio(a, b):
@@ -57,16 +62,22 @@ def oracle_curves(st, metric, cost):
 
 
 def equal_error_table(studies, metric):
+    """Per scene and error level: each oracle's leaves and seconds to reach it, the
+    ratios, and each oracle's exposure error there (interpolated along its curve
+    at the leaves it needs: the solutions compared are equally good by `metric`,
+    not necessarily equally bright)."""
     lines = ["| scene | error | std leaves | perc leaves | grad leaves | perc/std leaves | grad/std leaves "
-             "| std s | perc s | grad s | perc/std time | grad/std time |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| std s | perc s | grad s | perc/std time | grad/std time | std exposure | perc exposure "
+             "| grad exposure |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     summary = {}
     for st in studies:
         by_leaves = oracle_curves(st, metric, "leaves")
         by_time = oracle_curves(st, metric, "seconds")
+        exposure = oracle_curves(st, "exposure_cycles", "leaves")
         levels = curves.common_levels(list(by_leaves.values()))
         if not levels:
-            lines.append("| %s | curves do not overlap | | | | | | | | | | |" % st.name)
+            lines.append("| %s | curves do not overlap | | | | | | | | | | | | | |" % st.name)
             continue
         for level in levels:
             nb = {o: curves.cost_to_reach(*by_leaves[o], level) for o in study_config.ORACLES}
@@ -74,51 +85,59 @@ def equal_error_table(studies, metric):
             # Ratios only where both costs are interpolated, not bounds.
             n = {o: v for o, (bound, v) in nb.items() if bound == "="}
             t = {o: v for o, (bound, v) in tb.items() if bound == "="}
+            ex = {o: curves.value_at_cost(*exposure[o], nb[o][1]) for o in study_config.ORACLES}
             rn, rt = ratio(n.get("perceptual"), n.get("standard")), ratio(t.get("perceptual"), t.get("standard"))
             summary.setdefault(st.name, []).append((rn, rt))
-            lines.append("| %s | %s | %s | %s | %s | **%s** | %s | %s | %s | %s | **%s** | %s |" % (
+            lines.append("| %s | %s | %s | %s | %s | **%s** | %s | %s | %s | %s | **%s** | %s | %s | %s | %s |" % (
                 st.name, fmt(level), bounded(nb["standard"]), bounded(nb["perceptual"]), bounded(nb["gradient"]),
                 fmt(rn), fmt(ratio(n.get("gradient"), n.get("standard"))), bounded(tb["standard"]),
                 bounded(tb["perceptual"]), bounded(tb["gradient"]), fmt(rt),
-                fmt(ratio(t.get("gradient"), t.get("standard")))))
+                fmt(ratio(t.get("gradient"), t.get("standard"))),
+                pct(ex["standard"]), pct(ex["perceptual"]), pct(ex["gradient"])))
     return lines, summary
 
 
 def regression_table(studies):
-    lines = ["| scene | oracle | n | a (s) | b (s per element) | r | time at 5000 leaves (s) |",
-             "|---|---|---|---|---|---|---|"]
+    lines = ["| scene | oracle | n | a (s) | b (s per element) | r | time at 5000 leaves (s) | exposure errors |",
+             "|---|---|---|---|---|---|---|---|"]
     for st in studies:
         for oracle in study_config.ORACLES:
             rows = [r for r in st.rows if r["method"] == "radiosity" and r["oracle"] == oracle]
             a, b, r, n = curves.least_squares([x["leaves"] for x in rows], [x["seconds"] for x in rows])
-            lines.append("| %s | %s | %d | %s | %s | %s | %s |" % (st.name, oracle, n, fmt(a), fmt(b, 4), fmt(r),
-                                                                fmt(a + 5000 * b)))
+            lines.append("| %s | %s | %d | %s | %s | %s | %s | %s |" % (
+                st.name, oracle, n, fmt(a), fmt(b, 4), fmt(r), fmt(a + 5000 * b), exposure_range(rows)))
     return lines
 
 
 def bake_tables(studies):
-    lines = ["| scene | vertices | samples | bake s | DoG vs refined | RMS vs refined | DoG vs Cycles | RMS vs Cycles |",
-             "|---|---|---|---|---|---|---|---|"]
+    lines = ["| scene | vertices | samples | bake s | DoG vs refined | RMS vs refined | DoG vs Cycles | RMS vs Cycles "
+             "| exposure vs Cycles |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for st in studies:
         for b in sorted(st.bake_rows, key=lambda b: (b["vertices"], b["samples"])):
-            lines.append("| %s | %d | %d | %s | %s | %s | %s | %s |" % (
+            lines.append("| %s | %d | %d | %s | %s | %s | %s | %s | %s |" % (
                 st.name, b["vertices"], b["samples"], fmt(b["seconds"]), fmt(b["dog_refined"]),
-                fmt(b["rms_refined"]), fmt(b["dog_cycles"]), fmt(b["rms_cycles"])))
+                fmt(b["rms_refined"]), fmt(b["dog_cycles"]), fmt(b["rms_cycles"]), pct(b["exposure_cycles"])))
     # For each bake: the time each oracle needs to be at least as good against the
     # Cycles reference (interpolated; "<=" even its cheapest solve is; ">" never).
     lines += ["", "Time each oracle needs to reach each bake's error against the **Cycles** reference "
               "(interpolated along its curve; `<= t`: even its cheapest solve is as good; `> t`: not reached "
               "by its dearest solve):", "",
-              "| scene | vertices | samples | metric | bake error | bake s | standard s | perceptual s | gradient s |",
-              "|---|---|---|---|---|---|---|---|---|"]
+              "| scene | vertices | samples | metric | bake error | bake s | bake exposure | standard s "
+              "| perceptual s | gradient s | standard exposure | perceptual exposure | gradient exposure |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for st in studies:
+        exposure = oracle_curves(st, "exposure_cycles", "seconds")
         for metric in ("dog_cycles", "rms_cycles"):
             rad = oracle_curves(st, metric, "seconds")
             for b in sorted(st.bake_rows, key=lambda b: (b["vertices"], b["samples"])):
-                cells = [bounded(curves.cost_to_reach(*rad[o], b[metric])) for o in study_config.ORACLES]
-                lines.append("| %s | %d | %d | %s | %s | %s | %s |" % (
+                reach = [curves.cost_to_reach(*rad[o], b[metric]) for o in study_config.ORACLES]
+                cells = [bounded(c) for c in reach]
+                # Each oracle's exposure where it reaches the bake's error (its dearest solve if it never does).
+                ex = [pct(curves.value_at_cost(*exposure[o], c[1])) for o, c in zip(study_config.ORACLES, reach)]
+                lines.append("| %s | %d | %d | %s | %s | %s | %s | %s | %s |" % (
                     st.name, b["vertices"], b["samples"], metric.split("_")[0], fmt(b[metric]), fmt(b["seconds"]),
-                    " | ".join(cells)))
+                    pct(b["exposure_cycles"]), " | ".join(cells), " | ".join(ex)))
     return lines
 
 
@@ -147,7 +166,8 @@ def write(path, studies, settings, plots, figures, seconds):
            "- Error (Section 6.2.3): brightness = Rec. 709 luminance clipped to [0, 1] and sRGB-encoded (the "
            "displayed value); **DoG** = eq. 24 on the centre-surround filtered brightness (difference of "
            "Gaussians, sigma %s px centre and %s px surround, i.e. width/160 and 1.6 times that); **RMS** = eq. "
-           "24 on the unfiltered brightness." % ((fmt(sig[0]), fmt(sig[1])) if sig else ("?", "?")),
+           "24 on the unfiltered brightness; **exposure** = mean linear luminance against the path-traced "
+           "reference, signed (below)." % ((fmt(sig[0]), fmt(sig[1])) if sig else ("?", "?")),
            "- References: (a) a far more refined radiosity solution (standard oracle, as in the source, so any "
            "bias favours the standard oracle); (b) Cycles path tracing of the original scene with Lambertian "
            "materials (32 bounces, no clamping), mean of %d seeds of %d samples."
@@ -157,34 +177,40 @@ def write(path, studies, settings, plots, figures, seconds):
            "time = the bake operator.", "",
            "## Scenes and references", "",
            "| scene | quality range | refined reference | its leaves | its time (s) | Cycles ref. noise DoG | "
-           "noise RMS | refined vs Cycles DoG | refined vs Cycles RMS | exposure refined / Cycles |",
-           "|---|---|---|---|---|---|---|---|---|---|"]
+           "noise RMS | noise exposure | refined vs Cycles DoG | refined vs Cycles RMS | refined exposure error |",
+           "|---|---|---|---|---|---|---|---|---|---|---|"]
     for st in studies:
         ref = next(r for r in st.rows if r["method"] == "refined")
-        out.append("| %s | %s-%s | %s q=%s | %d | %s | %s | %s | %s | %s | %s |" % (
+        out.append("| %s | %s-%s | %s q=%s | %d | %s | %s | %s | %s | %s | %s | %s |" % (
             st.name, fmt(st.quality_range[0]), fmt(st.quality_range[1]), st.reference[0], fmt(st.reference[1]),
             ref["leaves"], fmt(ref["seconds"]), fmt(st.noise["dog"]), fmt(st.noise["rms"]),
-            fmt(st.refined_vs_cycles["dog"]), fmt(st.refined_vs_cycles["rms"]), fmt(exposure_ratio(st), 4)))
+            "%.2f %%" % (100 * st.noise["exposure"]), fmt(st.refined_vs_cycles["dog"]),
+            fmt(st.refined_vs_cycles["rms"]), pct(st.refined_vs_cycles["exposure"])))
     out += ["", "The Cycles reference's noise is the error its own noise alone causes (measured from the "
             "difference of its seeds); errors against it below that level are not resolved. 'Refined vs Cycles' "
             "is the floor every radiosity curve meets against the Cycles reference (the solver's remaining bias "
-            "plus that noise). Exposure: mean linear luminance (clipped at 1) of the refined solution's snapshot "
-            "over the path-traced one's; 1 means the two renders agree in brightness (the solver is known to "
-            "come out a few per cent dark in closed rooms, tests/blender/test_cycles.py).", ""]
+            "plus that noise). **Exposure error**: mean linear luminance (not clipped) of a snapshot over the "
+            "path-traced one's, minus 1, the pixels the emitters cover left out (the measure of "
+            "tests/blender/test_contact.py); > 0 is too bright. Neither DoG (the centre-surround filter removes "
+            "brightness) nor RMS (on clipped, sRGB-encoded brightness) shows it, so every table below states it "
+            "beside them: a solution can score well and still be too bright (light leaking past contacts, "
+            "issue 12) or too dark (energy lost per bounce in closed rooms).", ""]
     out += ["## Elements and time at equal error", "",
             "For each scene, three error levels inside the range all oracles reach; the leaves and seconds each "
-            "oracle needs to get at least that good (lower envelope of its curve, log-log interpolation). "
-            "The source claims perceptual/standard of about 0.5 for both.", ""]
+            "oracle needs to get at least that good (lower envelope of its curve, log-log interpolation), and "
+            "each oracle's exposure error there (interpolated along its solves in log leaves): equal error does "
+            "not mean equal brightness. The source claims perceptual/standard of about 0.5 for both.", ""]
     summaries = {}
     for metric, label in METRICS:
         lines, summary = equal_error_table(studies, metric)
         summaries[metric] = summary
         out += ["### %s" % label, ""] + lines + [""]
     out += ["### Summary: median perceptual/standard ratio over the levels", "",
+            "With the range of each oracle's exposure errors over its whole sweep.", "",
             "| scene | " + " | ".join("%s leaves | %s time" % (m.split("_")[0] + " " + m.split("_")[1],
                                                                m.split("_")[0] + " " + m.split("_")[1])
-                                      for m, _ in METRICS) + " |",
-            "|---|" + "---|---|" * len(METRICS)]
+                                      for m, _ in METRICS) + " | std exposure | perc exposure | grad exposure |",
+            "|---|" + "---|---|" * len(METRICS) + "---|---|---|"]
     for st in studies:
         cells = []
         for metric, _ in METRICS:
@@ -192,16 +218,19 @@ def write(path, studies, settings, plots, figures, seconds):
             for k in (0, 1):
                 vals = [p[k] for p in pairs if p[k] is not None]
                 cells.append(fmt(float(np.median(vals))) if vals else "-")
+        cells += [exposure_range([r for r in st.rows if r["method"] == "radiosity" and r["oracle"] == o])
+                  for o in study_config.ORACLES]
         out.append("| %s | %s |" % (st.name, " | ".join(cells)))
     out += ["", "## Time against elements (Section 7.3.4: time = a + b x leaves)", ""] + regression_table(studies)
     out += ["", "## Equal-size comparison (Sections 7.4-7.5.2)", "",
-            "| scene | oracle | leaves | DoG vs refined | RMS vs refined | DoG vs Cycles | RMS vs Cycles |",
-            "|---|---|---|---|---|---|---|"]
+            "| scene | oracle | leaves | DoG vs refined | RMS vs refined | DoG vs Cycles | RMS vs Cycles "
+            "| exposure vs Cycles |",
+            "|---|---|---|---|---|---|---|---|"]
     for st in studies:
         for oracle, r in st.comparison.items():
-            out.append("| %s | %s | %d | %s | %s | %s | %s |" % (st.name, oracle, r["leaves"], fmt(r["dog_refined"]),
-                                                                fmt(r["rms_refined"]), fmt(r["dog_cycles"]),
-                                                                fmt(r["rms_cycles"])))
+            out.append("| %s | %s | %d | %s | %s | %s | %s | %s |" % (
+                st.name, oracle, r["leaves"], fmt(r["dog_refined"]), fmt(r["rms_refined"]), fmt(r["dog_cycles"]),
+                fmt(r["rms_cycles"]), pct(r["exposure_cycles"])))
     out += ["", "## Cycles bake (what a Blender user would do instead)", ""] + bake_tables(studies)
     out += ["", "## Files", ""] + ["- `%s`" % os.path.basename(str(p)) for p in list(plots) + list(figures)]
     out += ["- `study.csv`: every solve and bake with its errors; images and solutions under `study/<scene>/`", ""]

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Builds every bundled scene into BUILD/scenes/NAME.blend, one Blender process each.
+"""Builds every bundled scene (and the contact scenes) into BUILD/scenes/NAME.blend, one Blender process each.
 
     /usr/bin/python3 scenes/build_all.py --build build --blender blender [NAME ...]
 """
@@ -13,7 +13,9 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from catalog import SCENES  # noqa: E402
+from catalog import CONTACT_SCENES, SCENES  # noqa: E402
+
+ALL = {**SCENES, **CONTACT_SCENES}
 
 
 def build_scene(blender, name, out):
@@ -29,25 +31,25 @@ def main():
     parser.add_argument("--build", default="build", help="build directory")
     parser.add_argument("--blender", default="blender", help="Blender executable")
     parser.add_argument("names", nargs="*", metavar="NAME",
-                        help="scenes to build (default: all of %s)" % ", ".join(SCENES))
+                        help="scenes to build (default: all of %s)" % ", ".join(ALL))
     args = parser.parse_args()
-    unknown = [n for n in args.names if n not in SCENES]
+    unknown = [n for n in args.names if n not in ALL]
     if unknown:
-        parser.error("unknown scene(s) %s; known: %s" % (", ".join(unknown), ", ".join(SCENES)))
+        parser.error("unknown scene(s) %s; known: %s" % (", ".join(unknown), ", ".join(ALL)))
 
     out_dir = Path(args.build) / "scenes"
     out_dir.mkdir(parents=True, exist_ok=True)
     failed = 0
-    for name in args.names or SCENES:
+    for name in args.names or ALL:
         out = out_dir / ("%s.blend" % name)
         out.unlink(missing_ok=True)
         start = time.perf_counter()
         ok, log = build_scene(args.blender, name, out)
         if ok:
-            print("%-8s %s (%.1f s)" % (name, out, time.perf_counter() - start))
+            print("%-15s %s (%.1f s)" % (name, out, time.perf_counter() - start))
         else:
             failed += 1
-            print("%-8s FAILED\n%s" % (name, log), file=sys.stderr)
+            print("%-15s FAILED\n%s" % (name, log), file=sys.stderr)
     return 1 if failed else 0
 
 

@@ -2,7 +2,8 @@
 
     blender -b --factory-startup --python scenes/build_scene.py -- NAME OUT.blend
 
-NAME is one of catalog.SCENES; each has a module NAME.py here with build(scene).
+NAME is one of catalog.SCENES or catalog.CONTACT_SCENES; each has a module NAME.py
+here with build(scene).
 """
 
 import importlib
@@ -17,11 +18,13 @@ import catalog  # noqa: E402  (needs the path above)
 import scene_kit  # noqa: E402
 
 
-def build(name, scene):
-    """Fill `scene` (empty) with the scene called `name`."""
-    if name not in catalog.SCENES:
-        raise ValueError("unknown scene %r; known: %s" % (name, ", ".join(catalog.SCENES)))
-    importlib.import_module(name).build(scene)
+def build(name, scene, **params):
+    """Fill `scene` (empty) with the scene called `name`; `params` go to its
+    builder (e.g. the Cornell box's gap=0.01)."""
+    known = {**catalog.SCENES, **catalog.CONTACT_SCENES}
+    if name not in known:
+        raise ValueError("unknown scene %r; known: %s" % (name, ", ".join(known)))
+    importlib.import_module(name).build(scene, **params)
 
 
 def main(argv):

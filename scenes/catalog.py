@@ -9,11 +9,23 @@ SCENES = {
     "office": "5 x 4 x 3 m room, table with four legs under a ceiling light",
     "full_office": "the office plus a chair, shelves and a cabinet: high occlusion",
     "dining_room": "8 x 6 x 3 m room, one small bright light over a table with chairs, dim corners",
+    "cornell_box": "the Cornell box as published (Lambertian), its light 0.1 mm under the ceiling, open front",
     "gradient_large_45": "Section 4.3.1 Fig. 22: occluder at 45 degrees, large emitter",
     "gradient_small_45": "Section 4.3.1 Fig. 23: occluder at 45 degrees, small emitter",
     "gradient_large_aligned": "Section 4.3.1 Fig. 24: occluder aligned, large emitter",
     "gradient_small_aligned": "Section 4.3.1 Fig. 25: occluder aligned, small emitter",
 }
 
-# Closed rooms (walls, floor, ceiling), as opposed to the open Section 4.3.1 set-ups.
+# Closed rooms (walls, floor, ceiling), as opposed to the open Section 4.3.1 set-ups
+# and the Cornell box (open at the front, as published).
 ROOMS = ("cube", "office", "full_office", "dining_room")
+
+# Scenes of contact and near-contact geometry (issue 12), built the way users
+# build them; the Cycles agreement tests (tests/blender/test_contact.py) and
+# bench/contact_gap.py use them with the Cornell box. Not in SCENES: they are
+# not rooms with one downward light like the bundled scenes.
+CONTACT_SCENES = {
+    "box_on_floor": "3 x 3 x 2.5 m room, a box standing on the floor (its bottom face on it) under an area light",
+    "lamp_on_table": "3 x 3 x 2.5 m room lit only by an emissive plane lying on a table top",
+    "picture_on_wall": "3 x 3 x 2.5 m room with a recessed ceiling light, a picture 1 mm in front of a wall",
+}

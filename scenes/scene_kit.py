@@ -3,8 +3,9 @@
 Geometry is built from numpy arrays of quads with outward (for objects) or
 inward (for rooms) normals, so every face's front side is the side that sees
 the rest of the scene. Materials are plain: Principled BSDF with a base colour
-and no specular layer (a diffuse surface, the scenes radiosity models), and an
-Emission shader for lights. Render settings make a Cycles render of the scene a
+and no specular layer (a diffuse surface, the scenes radiosity models), or a
+Diffuse BSDF where a scene is built Lambertian from the start (the Cornell box,
+the contact scenes), and an Emission shader for lights. Render settings make a Cycles render of the scene a
 reference for the radiosity solution: CPU, Standard view transform, enough
 diffuse bounces, no clamping.
 """
@@ -128,6 +129,23 @@ def diffuse_material(name, color):
     bsdf.inputs["Base Color"].default_value = (*color, 1.0)
     bsdf.inputs["Specular"].default_value = 0.0
     mat.diffuse_color = (*color, 1.0)  # the viewport colour in Solid shading
+    return mat
+
+
+def lambertian_material(name, color):
+    """A Lambertian material: a Diffuse BSDF of `color` (linear RGB), the surface
+    radiosity models exactly (the Principled BSDF's diffuse is not Lambertian).
+    The Diffuse BSDF node and its Color input are the same in Blender 3.x to 5.x."""
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    nodes.clear()
+    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
+    bsdf.inputs["Color"].default_value = (*color, 1.0)
+    output = nodes.new("ShaderNodeOutputMaterial")
+    output.location = (300, 0)
+    links.new(bsdf.outputs["BSDF"], output.inputs["Surface"])
+    mat.diffuse_color = (*color, 1.0)
     return mat
 
 

@@ -100,8 +100,13 @@ class Report:
         for test in result.unexpectedSuccesses:
             self.fail(test.id(), "unexpected success")
         self.data["skipped"] += len(result.skipped)
-        self.data["passed"] += (ran - len(result.failures) - len(result.errors)
-                                - len(result.unexpectedSuccesses) - len(result.skipped))
+        # Each failing subTest is a failure of its own, but a test counts as
+        # passed only if none of its subtests failed (so `passed` never goes
+        # below zero when one test has many failing subtests).
+        not_passed = {id(getattr(test, "test_case", test)) for test, _ in
+                      result.failures + result.errors + result.skipped}
+        not_passed |= {id(test) for test in result.unexpectedSuccesses}
+        self.data["passed"] += ran - len(not_passed)
 
 
 def main():

@@ -18,11 +18,15 @@ import numpy as np
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 
 
-def render_image(scene, samples, resolution=(96, 72)):
-    """Render `scene` with Cycles; (H, W, 3) linear float image."""
+def render_image(scene, samples, resolution=(96, 72), seed=None):
+    """Render `scene` with Cycles; (H, W, 3) linear float image. `seed`: Cycles'
+    sampling seed (default: the scene's)."""
     scene.render.engine = 'CYCLES'
     scene.cycles.device = 'CPU'
     scene.cycles.samples = samples
+    if seed is not None:
+        scene.cycles.seed = seed
+        scene.cycles.use_animated_seed = False
     scene.cycles.use_denoising = False
     scene.cycles.use_adaptive_sampling = False
     scene.render.resolution_x, scene.render.resolution_y = resolution
@@ -40,6 +44,43 @@ def render_image(scene, samples, resolution=(96, 72)):
         bpy.data.images.remove(image)
     w, h = resolution
     return pixels.reshape(h, w, 4)[::-1, :, :3]   # top row first
+
+
+def emitter_objects(scene):
+    """Objects that emit: lights, and meshes with a material the add-on reads as emitting."""
+    from radiosity import export
+    reader = export.MaterialReader()
+    return [o for o in scene.objects if o.type == 'LIGHT' or (
+        o.type == 'MESH' and any(reader.read(s.material)[1].max() > 0 for s in o.material_slots))]
+
+
+def emitter_mask(scene, samples=16, resolution=(96, 72)):
+    """(H, W) bool: the pixels an emitter covers or reaches through the pixel filter.
+
+    A render in which every other mesh is a holdout (black, but still hiding
+    what lies behind it) and nothing bounces; every pixel it lights, widened by
+    one pixel: an emitter many times brighter than a wall spreads into its
+    neighbours through the filter, at a weight the samples may miss."""
+    emitters = set(emitter_objects(scene))
+    others = [o for o in scene.objects if o.type == 'MESH' and o not in emitters]
+    bounces = scene.cycles.max_bounces
+    for obj in others:
+        obj.is_holdout = True
+    scene.cycles.max_bounces = 0
+    try:
+        image = render_image(scene, samples, resolution, seed=0)
+    finally:
+        for obj in others:
+            obj.is_holdout = False
+        scene.cycles.max_bounces = bounces
+    covered = image.max(axis=2) > 0.0
+    grown = covered.copy()   # the 3 x 3 neighbourhood of every covered pixel
+    grown[1:, :] |= covered[:-1, :]
+    grown[:-1, :] |= covered[1:, :]
+    rows = grown.copy()
+    grown[:, 1:] |= rows[:, :-1]
+    grown[:, :-1] |= rows[:, 1:]
+    return grown
 
 
 def save_png(image, path):

@@ -26,7 +26,7 @@ import catalog  # noqa: E402
 # The object each scene's camera must see, and that casts the shadow.
 SUBJECT = {"cube": "Cube", "office": "Table.Top", "full_office": "Table.Top",
            "dining_room": "Table.Top", "gradient_large_45": "Occluder", "gradient_small_45": "Occluder",
-           "gradient_large_aligned": "Occluder", "gradient_small_aligned": "Occluder"}
+           "gradient_large_aligned": "Occluder", "gradient_small_aligned": "Occluder", "cornell_box": "Block.Short"}
 
 
 def objects(scene):
@@ -125,10 +125,14 @@ class SceneBuildersTest(unittest.TestCase):
                 for mat in (obj.data.materials if obj.type == 'MESH' else []):
                     if emission_strength(mat) > 0:
                         continue
-                    bsdf = mat.node_tree.nodes["Principled BSDF"]
-                    rho = bsdf.inputs["Base Color"].default_value[:3]
+                    nodes = mat.node_tree.nodes
+                    if "Principled BSDF" in nodes:
+                        bsdf = nodes["Principled BSDF"]
+                        rho = bsdf.inputs["Base Color"].default_value[:3]
+                        self.assertEqual(bsdf.inputs["Specular"].default_value, 0.0, mat.name)
+                    else:   # Lambertian: a Diffuse BSDF (scene_kit.lambertian_material)
+                        rho = next(n for n in nodes if n.type == 'BSDF_DIFFUSE').inputs["Color"].default_value[:3]
                     self.assertTrue(all(0 <= c < 1 for c in rho), mat.name)
-                    self.assertEqual(bsdf.inputs["Specular"].default_value, 0.0, mat.name)
         self.for_each_scene(check)
         cube = self.scene("cube")
         left = objects(cube)["Wall.Left"].data.materials[0].diffuse_color
@@ -183,6 +187,83 @@ class SceneBuildersTest(unittest.TestCase):
                 self.assertTrue(0.05 < np.median(lit) < 0.8, np.median(lit))
             self.assertLess(np.mean(luminance > 1.0), 0.05)
         self.for_each_scene(check)
+
+
+class ContactScenesTest(unittest.TestCase):
+    """The scenes of issue 12 have the contact they are named for, and the Cornell
+    box is as published (millimetres in its own frame, y up: to_blender)."""
+
+    def build(self, name, **params):
+        scene = bpy.data.scenes.new(name)
+        build_scene.build(name, scene, **params)
+        scene.view_layers[0].update()
+        return scene, objects(scene)
+
+    def test_cornell_box_as_published_with_its_light_gap(self):
+        import cornell_box as cb
+        for gap in (1e-4, 1e-2):
+            scene, objs = self.build("cornell_box", gap=gap)
+            light = world_polygons(objs["Light"])
+            ceiling = world_polygons(objs["Ceiling"])
+            self.assertAlmostEqual(ceiling[0][0, 2] - light[0][0, 2], gap, places=6)   # float32 vertices
+            self.assertAlmostEqual(light[2][0], 0.130 * 0.105, places=7)   # 130 x 105 mm
+            np.testing.assert_allclose(light[1], [[0, 0, -1]], atol=1e-9)
+        # Walls face into the box, blocks out of themselves; each block stands on the floor.
+        inside = cb.to_blender((278.0, 274.4, 279.6))
+        for name in ("Floor", "Ceiling", "Wall.Back", "Wall.Left", "Wall.Right"):
+            centres, normals, _ = world_polygons(objs[name])
+            self.assertGreater(float(np.dot(normals[0], inside - centres[0])), 0, name)
+        for name, height in (("Block.Short", 0.165), ("Block.Tall", 0.330)):
+            obj = objs[name]
+            centres, normals, _ = world_polygons(obj)
+            self.assertEqual(len(centres), 5, name)   # no bottom face
+            middle = centres.mean(axis=0)
+            self.assertTrue(np.all(np.einsum("ij,ij->i", normals, centres - middle) > 0), name)
+            z = np.array([(obj.matrix_world @ v.co).z for v in obj.data.vertices])
+            self.assertAlmostEqual(z.min(), 0.0, places=9)
+            self.assertAlmostEqual(z.max(), height, places=6)
+        # The published left wall is not planar: its fourth corner is off the other three's plane.
+        wall = objs["Wall.Left"]
+        p = np.array([wall.matrix_world @ v.co for v in wall.data.vertices])
+        n = np.cross(p[1] - p[0], p[2] - p[0])
+        self.assertGreater(abs(np.dot(n / np.linalg.norm(n), p[3] - p[0])), 1e-4)
+        # The published camera; red on its left, green on its right (not mirrored).
+        cam = scene.camera
+        np.testing.assert_allclose(cam.location, (-0.278, -0.8, 0.273), atol=1e-9)
+        self.assertEqual((cam.data.lens, cam.data.sensor_width), (35.0, 25.0))
+        left = world_to_camera_view(scene, cam, Vector(world_polygons(objs["Wall.Left"])[0][0]))
+        right = world_to_camera_view(scene, cam, Vector(world_polygons(objs["Wall.Right"])[0][0]))
+        self.assertLess(left.x, 0.3)
+        self.assertGreater(right.x, 0.7)
+        self.assertGreater(objs["Wall.Left"].data.materials[0].diffuse_color[0], 5 * cb.RED[1])
+
+    def test_box_bottom_face_lies_on_the_floor(self):
+        scene, objs = self.build("box_on_floor")
+        centres, normals, areas = world_polygons(objs["Box"])
+        bottom = np.argmin(centres[:, 2])
+        self.assertEqual(len(centres), 6)
+        self.assertAlmostEqual(centres[bottom, 2], 0.0, places=9)
+        np.testing.assert_allclose(normals[bottom], [0, 0, -1], atol=1e-9)
+        self.assertEqual([o.data.type for o in scene.objects if o.type == 'LIGHT'], ['AREA'])
+
+    def test_lamp_lies_on_the_table_top(self):
+        import lamp_on_table
+        scene, objs = self.build("lamp_on_table")
+        lamp = world_polygons(objs["Lamp"])
+        table = world_polygons(objs["Table"])
+        top = np.argmax(table[0][:, 2])
+        self.assertAlmostEqual(lamp[0][0, 2] - table[0][top, 2], lamp_on_table.LIFT, places=6)
+        np.testing.assert_allclose(lamp[1], [[0, 0, 1]], atol=1e-9)
+        corners = np.array([objs["Lamp"].matrix_world @ v.co for v in objs["Lamp"].data.vertices])
+        t = np.array([objs["Table"].matrix_world @ v.co for v in objs["Table"].data.vertices])
+        self.assertTrue(np.all(corners[:, :2] > t[:, :2].min(0)) and np.all(corners[:, :2] < t[:, :2].max(0)))
+
+    def test_picture_hangs_1mm_in_front_of_the_wall(self):
+        scene, objs = self.build("picture_on_wall")
+        picture = world_polygons(objs["Picture"])
+        wall = world_polygons(objs["Wall.Back"])
+        self.assertAlmostEqual(wall[0][0, 1] - picture[0][0, 1], 1e-3, places=6)
+        np.testing.assert_allclose(picture[1], wall[1], atol=1e-9)   # both facing into the room
 
 
 if __name__ == "__main__":
