@@ -24,7 +24,7 @@ if "bpy" in locals():
     # Re-running register after F8 / "Reload Scripts": pick up edited modules.
     import importlib
 
-    for _name in ("native", "geometry", "export", "bake", "properties", "operators", "ui"):
+    for _name in ("native", "compat", "geometry", "export", "bake", "properties", "operators", "ui"):
         if _name in locals():
             importlib.reload(locals()[_name])
 

@@ -18,7 +18,7 @@ import json
 import bpy
 import numpy as np
 
-from . import geometry
+from . import compat, geometry
 from .export import HIDDEN_TAG, RESULT_TAG
 
 COLLECTION_NAME = "Radiosity"
@@ -90,9 +90,7 @@ def emission_material():
     links.new(transparent.outputs["BSDF"], mix.inputs[2])
     links.new(mix.outputs["Shader"], output.inputs["Surface"])
     # EEVEE: back faces culled and no shadows (the light is baked in).
-    mat.use_backface_culling = True
-    mat.blend_method = 'CLIP'
-    mat.shadow_method = 'NONE'
+    compat.set_cutout_transparency(mat)
     mat.diffuse_color = (1.0, 1.0, 1.0, 1.0)
     return mat
 
@@ -109,8 +107,7 @@ def build_mesh(name, positions, face_vertices, face_sizes, radiance):
     mesh.loops.foreach_set("vertex_index", np.ascontiguousarray(face_vertices, dtype=np.int32))
     mesh.polygons.add(len(face_sizes))
     starts = (np.cumsum(face_sizes) - face_sizes).astype(np.int32)
-    mesh.polygons.foreach_set("loop_start", starts)
-    mesh.polygons.foreach_set("loop_total", face_sizes)
+    compat.set_polygon_loops(mesh.polygons, starts, face_sizes)
     mesh.update(calc_edges=True)
     set_colour_attribute(mesh, radiance, 'POINT')
     return mesh

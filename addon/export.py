@@ -10,7 +10,7 @@ What is exported, as a Cycles render would see it:
   viewport colour) and emitted radiance (Emission colour x strength of a
   Principled BSDF or an Emission shader);
 - area lights as one-sided emitting polygons (rectangle, square, disk, ellipse)
-  with Blender's power-to-radiance conversion (geometry.area_light_factor).
+  with Blender's power-to-radiance conversion (geometry.area_light_radiance).
 What is not modelled (point, spot and sun lights, node setups other than the
 above) is collected in `ExportedScene.unmodelled` for one warning.
 """
@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import bpy
 import numpy as np
 
-from . import geometry
+from . import compat, geometry
 
 # Objects the add-on itself made, which must never be solved again.
 RESULT_TAG = "radiosity_result"
@@ -96,7 +96,7 @@ class MaterialReader:
         kind = node.type
         if kind == 'BSDF_PRINCIPLED':
             rho = self._colour(node.inputs["Base Color"], material)
-            emission = self._colour(node.inputs["Emission"], material)
+            emission = self._colour(compat.principled_emission(node), material)
             strength = _scalar(node.inputs.get("Emission Strength"), 1.0)
             if rho is None or emission is None or strength is None:
                 return None
@@ -248,8 +248,8 @@ def export_scene(context, blender_version=None):
             area = geometry.scaled_area(matrix, area)
             if area <= 0.0 or light.energy <= 0.0:
                 continue
-            radiance = (geometry.area_light_factor(version) * light.energy / area
-                        * np.array(light.color[:3], dtype=float))
+            radiance = geometry.area_light_radiance(version, light.energy, area, compat.light_colour(light),
+                                                   compat.light_exposure(light), compat.light_normalized(light))
             if getattr(light, "spread", math.pi) < math.pi - 1e-6:
                 light_notes.add("area light spread")
             if light.use_nodes:

@@ -10,17 +10,16 @@ import math
 
 import numpy as np
 
-# Power-to-radiance of a Blender area light, measured in Blender 3.4.1 Cycles
-# (not recalled): a white Diffuse BSDF plane 1 m under a 0.5 m square area
-# light of 10 W, rendered with direct light only (256 samples, 64x64, centre
-# pixels), gives exactly the same pixel value (0.72190 vs 0.72201) as under an
-# emissive 0.5 m quad of Emission strength 10, so L = 10 = P / (4 A). The same
-# holds for a 0.25 x 0.5 rectangle with object scale (2, 1, 1) (L A / P =
-# 0.24996), a 0.25 square with scale (2, 2, 1) (0.24996) and a 0.5 m disk
-# against an emissive 64-gon (0.25037): A is the area with the object's scale,
-# pi d^2 / 4 for disks. Script: tests/blender/measure_area_light.py.
-# Cycles 4.0 changed the normalisation to L = P / (pi A) (DESIGN.md section 3;
-# not measured here, no Blender 4 on this machine).
+# Power-to-radiance of a Blender area light, L = factor * P / A (A the area with
+# object scale, pi d^2 / 4 for disks), measured in Cycles, not recalled: a white
+# Diffuse BSDF plane 1 m under the light, direct light only, against an emissive
+# polygon of the same shape (tests/blender/test_light_conversion.py, which runs in
+# every tested Blender and records the numbers). Blender 3.4.1: L A / P = 0.2500
+# for squares and scaled rectangles, 0.2504 for a disk: 1/4. Blender 4.5.15 and
+# 5.0.1: 0.3183, disk 0.3188: 1/pi. Cycles changed it in 4.0 (DESIGN.md section
+# 3; 4.0 to 4.4 are not measured here). Since 4.x a light's exposure e multiplies
+# L by 2^e, and with `normalize` off L = factor * P, not divided by the area
+# (both measured in 4.5 and 5.0).
 AREA_LIGHT_FACTOR_BEFORE_4 = 0.25
 AREA_LIGHT_FACTOR_4 = 1.0 / math.pi
 
@@ -32,6 +31,15 @@ ROUND_LIGHT_SIDES = 16
 def area_light_factor(blender_version):
     """L = factor * P / A for Blender `blender_version` (a tuple like (3, 4, 1))."""
     return AREA_LIGHT_FACTOR_BEFORE_4 if tuple(blender_version) < (4, 0, 0) else AREA_LIGHT_FACTOR_4
+
+
+def area_light_radiance(blender_version, power, area, colour, exposure=0.0, normalize=True):
+    """Radiance (rgb) of an area light of `power` W and world `area` (m^2) in Blender
+    `blender_version`; `exposure` (stops) and `normalize` as the light's (4.x)."""
+    radiance = area_light_factor(blender_version) * power * 2.0 ** exposure
+    if normalize:
+        radiance /= area
+    return radiance * np.asarray(colour, dtype=float)
 
 
 def area_light_polygon(shape, size_x, size_y, sides=ROUND_LIGHT_SIDES):

@@ -25,6 +25,16 @@ class AreaLightTest(unittest.TestCase):
         self.assertEqual(geometry.area_light_factor((3, 4, 1)), 0.25)
         self.assertAlmostEqual(geometry.area_light_factor((4, 1, 0)), 1 / math.pi)
 
+    def test_radiance_with_exposure_and_normalize(self):
+        colour = (1.0, 0.5, 0.25)
+        np.testing.assert_allclose(geometry.area_light_radiance((3, 4, 1), 10.0, 0.5, colour),
+                                   [5.0, 2.5, 1.25])
+        np.testing.assert_allclose(geometry.area_light_radiance((4, 5, 0), 10.0, 0.5, colour, exposure=2.0),
+                                   np.multiply(colour, 4 * 10.0 / (math.pi * 0.5)))
+        # Not normalized: the power is not spread over the area.
+        np.testing.assert_allclose(geometry.area_light_radiance((4, 5, 0), 10.0, 0.5, colour, normalize=False),
+                                   np.multiply(colour, 10.0 / math.pi))
+
     def test_shapes_face_down_with_the_ideal_area(self):
         for shape, sx, sy, area in (('SQUARE', 0.5, 9.0, 0.25), ('RECTANGLE', 0.5, 0.2, 0.1),
                                     ('DISK', 0.5, 9.0, math.pi * 0.0625),

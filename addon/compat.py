@@ -1,0 +1,57 @@
+"""What differs between the Blenders the add-on runs in (3.4 to 5.0), in one place.
+
+Each difference is detected by feature (does the socket or property exist, is it
+writable), so a Blender between or after the tested ones (3.4, 4.5, 5.0) takes the
+path its API has. Only the area light's power-to-radiance factor goes by version,
+since nothing in the API tells it (geometry.area_light_factor).
+"""
+
+import bpy
+import numpy as np
+
+
+def principled_emission(node):
+    """The emission colour input of a Principled BSDF: "Emission" in 3.x,
+    "Emission Color" since Principled v2 (4.0)."""
+    socket = node.inputs.get("Emission Color")
+    return socket if socket is not None else node.inputs["Emission"]
+
+
+def set_polygon_loops(polygons, starts, sizes):
+    """Give new polygons their loops. Blender 3.4 needs loop_total written; since
+    3.6 it is read-only, derived from the next polygon's loop_start."""
+    polygons.foreach_set("loop_start", starts)
+    if not bpy.types.MeshPolygon.bl_rna.properties["loop_total"].is_readonly:
+        polygons.foreach_set("loop_total", sizes)
+
+
+def light_colour(light):
+    """Linear RGB of a light: its colour, times its blackbody colour where it uses a
+    temperature (4.5: use_temperature, temperature_color)."""
+    colour = np.array(light.color[:3], dtype=float)
+    if getattr(light, "use_temperature", False):
+        colour *= np.array(light.temperature_color[:3], dtype=float)
+    return colour
+
+
+def light_exposure(light):
+    """A light's exposure in stops (4.x lights; 0 before: power as given)."""
+    return float(getattr(light, "exposure", 0.0))
+
+
+def light_normalized(light):
+    """Whether a light's power is spread over its area (always before 4.x, where
+    lights have `normalize`)."""
+    return bool(getattr(light, "normalize", True))
+
+
+def set_cutout_transparency(material):
+    """EEVEE shows the baked material's transparent back faces as cut-outs, without
+    shadows: blend_method 'CLIP' and shadow_method 'NONE' before EEVEE Next (4.2),
+    surface_render_method 'DITHERED' since (its shadows follow the surface)."""
+    material.use_backface_culling = True
+    if hasattr(material, "surface_render_method"):
+        material.surface_render_method = 'DITHERED'
+    else:
+        material.blend_method = 'CLIP'
+        material.shadow_method = 'NONE'

@@ -1,0 +1,129 @@
+#!/usr/bin/env python3
+"""The Blenders the project runs in, and how each is had (the one table of them).
+
+    3.4  Debian 12's package `blender` (installed by .ci/install-deps.sh): `blender`
+    4.5  bpy 4.5 LTS from PyPI (Blender as a Python module)
+    5.0  bpy 5.0 from PyPI (the newest bpy PyPI serves for Python 3.11)
+
+Each bpy is installed once, pinned, into its own virtual environment of Debian's
+Python 3.11 (the Python the native module is built for) under BUILD/blenders/NAME,
+with a `blender` command in it (tools/blender_cli.py) that takes Blender's
+command-line options: every script and test that starts "a Blender" starts any
+of the three the same way. Later runs reuse the environment; a changed pin
+replaces it.
+
+    python3 tools/blenders.py install --build build 3.4 4.5 5.0   # what is missing
+    python3 tools/blenders.py executable --build build 4.5        # prints its command
+
+A name not in the table is taken as the path of a Blender executable.
+"""
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+CLI = ROOT / "tools" / "blender_cli.py"
+# The interpreter of every bpy environment: bpy wheels for 4.5 and 5.0 are cp311 only.
+BASE_PYTHON = "/usr/bin/python3.11"
+
+# name -> pip requirements of its environment (None: the system's `blender`).
+# numpy is pinned too, so a later numpy release cannot change a test run.
+BLENDERS = {
+    "3.4": None,
+    "4.5": ["bpy==4.5.15", "numpy==1.26.4"],
+    "5.0": ["bpy==5.0.1", "numpy==1.26.4"],
+}
+DEFAULT = ["3.4", "4.5", "5.0"]
+
+
+class BlenderError(RuntimeError):
+    """A Blender that cannot be had; the message says what to do."""
+
+
+def env_dir(build, name):
+    return Path(build).resolve() / "blenders" / name
+
+
+def _stamp(build, name):
+    return env_dir(build, name) / "installed.txt"
+
+
+def executable(build, name):
+    """The command that runs Blender `name` (a table name or a path), installed or not."""
+    if name not in BLENDERS:
+        return str(Path(name).resolve()) if os.sep in name else name
+    if BLENDERS[name] is None:
+        return "blender"
+    return str(env_dir(build, name) / "bin" / "blender")
+
+
+def installed(build, name):
+    if name not in BLENDERS:
+        return shutil.which(name) is not None or Path(name).is_file()
+    if BLENDERS[name] is None:
+        return shutil.which("blender") is not None
+    stamp = _stamp(build, name)
+    return stamp.exists() and stamp.read_text().split() == BLENDERS[name]
+
+
+def install(build, name, log=print):
+    """Make Blender `name` runnable; a no-op when it already is."""
+    if installed(build, name):
+        return
+    if name not in BLENDERS:
+        raise BlenderError("no Blender at %r (names known: %s)" % (name, ", ".join(BLENDERS)))
+    if BLENDERS[name] is None:
+        raise BlenderError("Debian's `blender` is not installed: run `make deps` (.ci/install-deps.sh)")
+    if not Path(BASE_PYTHON).exists():
+        raise BlenderError("%s not found: install Debian's python3 and python3-venv (make deps)" % BASE_PYTHON)
+    folder = env_dir(build, name)
+    requirements = BLENDERS[name]
+    log("Installing Blender %s (%s) into %s" % (name, " ".join(requirements), folder))
+    start = time.perf_counter()
+    if folder.exists():
+        shutil.rmtree(folder)
+    subprocess.run([BASE_PYTHON, "-m", "venv", str(folder)], check=True)
+    pip = [str(folder / "bin" / "python"), "-m", "pip", "--disable-pip-version-check"]
+    subprocess.run(pip + ["install", "--quiet", "--only-binary", ":all:", *requirements], check=True)
+    write_launcher(folder, name)
+    _stamp(build, name).write_text(" ".join(requirements) + "\n")
+    log("Installed Blender %s in %.0f s" % (name, time.perf_counter() - start))
+
+
+def write_launcher(folder, name):
+    """FOLDER/bin/blender: tools/blender_cli.py run by the environment's Python."""
+    launcher = folder / "bin" / "blender"
+    # A Python script of the environment, so that sys.argv[0] (and so bpy.app.binary_path,
+    # which scripts use to start another Blender) is this command.
+    launcher.write_text("#!%s\n# Blender %s (bpy) with Blender's command line\n"
+                        "import sys\nsys.path.insert(0, %r)\nimport blender_cli\nsys.exit(blender_cli.main())\n"
+                        % (folder / "bin" / "python", name, str(CLI.parent)))
+    launcher.chmod(0o755)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("action", choices=("install", "executable"))
+    parser.add_argument("--build", default="build", help="build directory")
+    parser.add_argument("names", nargs="*", default=None,
+                        help="Blenders: %s, or paths (default: all)" % ", ".join(BLENDERS))
+    args = parser.parse_intermixed_args()
+    names = args.names or DEFAULT
+    try:
+        if args.action == "install":
+            for name in names:
+                install(args.build, name)
+        else:
+            for name in names:
+                print(executable(args.build, name))
+    except (BlenderError, subprocess.CalledProcessError) as err:
+        sys.exit("error: %s" % err)
+
+
+if __name__ == "__main__":
+    main()
