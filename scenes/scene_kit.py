@@ -121,13 +121,26 @@ def add_mesh(scene, name, geometry, material, location=(0, 0, 0), rotation=(0, 0
     return obj
 
 
+# Principled BSDF inputs that Principled v2 (Blender 4.0) renamed: 3.x name -> 4.x name.
+# Both "Specular" and "Specular IOR Level" at 0 mean no specular layer.
+PRINCIPLED_V2_NAMES = {"Specular": "Specular IOR Level", "Emission": "Emission Color"}
+
+
+def principled_input(node, name):
+    """Input `name` (its 3.x name) of a Principled BSDF node, in any Blender."""
+    renamed = PRINCIPLED_V2_NAMES.get(name)
+    if renamed is not None and renamed in node.inputs:
+        return node.inputs[renamed]
+    return node.inputs[name]
+
+
 def diffuse_material(name, color):
     """A diffuse material: Principled BSDF with `color` (linear RGB) and no specular."""
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     bsdf = mat.node_tree.nodes["Principled BSDF"]
     bsdf.inputs["Base Color"].default_value = (*color, 1.0)
-    bsdf.inputs["Specular"].default_value = 0.0
+    principled_input(bsdf, "Specular").default_value = 0.0
     mat.diffuse_color = (*color, 1.0)  # the viewport colour in Solid shading
     return mat
 

@@ -5,14 +5,17 @@ Three kinds of tests, run in this order:
   ctest           the C++ unit tests registered with CTest in the build dir
   native/test_*   unittest files for the `_radiosity` module, run by /usr/bin/python3
                   with build/addon/radiosity on sys.path (no Blender)
-  blender/test_*  unittest files run inside `blender --background --factory-startup`,
-                  one Blender process per file, with the add-on registered
+  blender/test_*  unittest files run inside each Blender given (--blender, repeatable:
+                  3.4, 4.5, 5.0 of tools/blenders.py, installed when missing, or a path),
+                  `blender --background --factory-startup`, one process per file,
+                  with the add-on registered; the group is named after its Blender
+                  (blender-4.5/test_solve.py), so each failure names its Blender
 
-One line per group (name, passed, failed, seconds), the output of failures, and
-a last line `N passed, M failed`. Exits non-zero if anything failed, errored or
-crashed, or if nothing ran at all.
+One line per group (name, passed, failed, skipped, seconds), the output of
+failures, one line per Blender, and a last line `N passed, M failed`. Exits
+non-zero if anything failed, errored or crashed, or if nothing ran at all.
 
-    /usr/bin/python3 tests/run_tests.py --build build --blender blender [-k PATTERN] [-v]
+    /usr/bin/python3 tests/run_tests.py --build build --blender 3.4 --blender 4.5 [-k PATTERN] [-v]
 """
 
 import argparse
@@ -30,6 +33,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 TESTS = ROOT / "tests"
+sys.path.insert(0, str(ROOT / "tools"))
+import blenders  # noqa: E402  (the table of Blenders, tools/blenders.py)
 RUNNER = TESTS / "unittest_runner.py"
 LOG_TAIL = 80  # lines of a crashed process' output worth showing
 
@@ -37,15 +42,17 @@ LOG_TAIL = 80  # lines of a crashed process' output worth showing
 class Outcome:
     """The result of one group: counts and what to show when it failed."""
 
-    def __init__(self, name, passed=0, failed=0, seconds=0.0, details="", ran=True):
-        self.name, self.passed, self.failed = name, passed, failed
-        self.seconds, self.details, self.ran = seconds, details, ran
+    def __init__(self, name, passed=0, failed=0, seconds=0.0, details="", ran=True, skipped=0, blender=None):
+        self.name, self.passed, self.failed, self.skipped = name, passed, failed, skipped
+        self.seconds, self.details, self.ran, self.blender = seconds, details, ran, blender
 
 
 def parse_args():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--build", default="build", help="CMake build directory")
-    parser.add_argument("--blender", default="blender", help="Blender executable")
+    parser.add_argument("--blender", dest="blenders", action="append", default=[],
+                        help="a Blender to run tests/blender in: %s (tools/blenders.py) or a path; "
+                             "repeatable (default: 3.4)" % ", ".join(blenders.BLENDERS))
     parser.add_argument("--python", default="/usr/bin/python3",
                         help="interpreter for tests/native (Blender's Python version)")
     parser.add_argument("-k", dest="patterns", action="append", default=[],
@@ -177,7 +184,7 @@ def run_unittest_file(name, cmd, json_out, timeout, verbose):
         parts.append(output)
     passed = report["passed"]
     ran = passed + failed + report["skipped"] > 0
-    return Outcome(name, passed, failed, seconds, "\n".join(parts), ran=ran)
+    return Outcome(name, passed, failed, seconds, "\n".join(parts), ran=ran, skipped=report["skipped"])
 
 
 def blender_crash_log(output):
@@ -191,13 +198,13 @@ def blender_crash_log(output):
         return ""
 
 
-def native_command(args, build, testfile, json_out, patterns):
-    return [args.python, str(RUNNER), "--path", str(build / "addon" / "radiosity"),
+def native_command(python, build, testfile, json_out, patterns):
+    return [python, str(RUNNER), "--path", str(build / "addon" / "radiosity"),
             *pattern_options(patterns), str(testfile), json_out]
 
 
-def blender_command(args, build, testfile, json_out, patterns):
-    return [args.blender, "--background", "--factory-startup", "--python-exit-code", "1",
+def blender_command(blender, build, testfile, json_out, patterns):
+    return [blender, "--background", "--factory-startup", "--python-exit-code", "1",
             "--python", str(RUNNER), "--",
             "--path", str(build / "addon"), "--register", "radiosity",
             *pattern_options(patterns), str(testfile), json_out]
@@ -208,48 +215,80 @@ def pattern_options(patterns):
 
 
 def python_jobs(args, build, tmp):
-    """(name, command, json path) of every selected Python test file."""
+    """(name, Blender label or None, command, json path) of every selected Python test file."""
+    kinds = [("native", None, args.python, native_command)]
+    kinds += [("blender-%s" % label, label, exe, blender_command) for label, exe in args.blender_exes]
     jobs = []
-    for kind, make_cmd in (("native", native_command), ("blender", blender_command)):
-        for testfile in sorted((TESTS / kind).glob("test_*.py")):
-            name = "%s/%s" % (kind, testfile.name)
+    for group, label, program, make_cmd in kinds:
+        folder = TESTS / ("native" if label is None else "blender")
+        for testfile in sorted(folder.glob("test_*.py")):
+            name = "%s/%s" % (group, testfile.name)
             json_out = str(Path(tmp) / (name.replace("/", "__") + ".json"))
             # A pattern naming the file runs all of it; otherwise the runner filters test ids.
             patterns = [] if matches(name, args.patterns) else args.patterns
-            jobs.append((name, make_cmd(args, build, testfile, json_out, patterns), json_out))
+            jobs.append((name, label, make_cmd(program, build, testfile, json_out, patterns), json_out))
     return jobs
+
+
+def resolve_blenders(args, build):
+    """[(label, executable)] of the Blenders asked for, installing a missing bpy first."""
+    found = []
+    for name in args.blenders or ["3.4"]:
+        blenders.install(build, name)
+        found.append((name, blenders.executable(build, name)))
+    return found
 
 
 # --- Reporting -------------------------------------------------------------------
 
 def print_outcome(outcome):
     if not outcome.ran and not outcome.failed:
-        print("--   %-34s no tests selected" % outcome.name, flush=True)
+        print("--   %-40s no tests selected" % outcome.name, flush=True)
         return
     mark = "FAIL" if outcome.failed else "ok"
-    print("%-4s %-34s %4d passed %4d failed %7.1f s"
-          % (mark, outcome.name, outcome.passed, outcome.failed, outcome.seconds), flush=True)
+    skipped = " %3d skipped" % outcome.skipped if outcome.skipped else ""
+    print("%-4s %-40s %4d passed %4d failed %7.1f s%s"
+          % (mark, outcome.name, outcome.passed, outcome.failed, outcome.seconds, skipped), flush=True)
     if outcome.details:
         print("\n".join("     | " + line for line in outcome.details.splitlines()), flush=True)
+
+
+def print_blender_totals(outcomes, labels):
+    """Per Blender: its tests' counts and the time its processes took."""
+    for label in labels:
+        mine = [o for o in outcomes if o.blender == label]
+        print("Blender %-5s %4d passed %4d failed %4d skipped %7.1f s"
+              % (label, sum(o.passed for o in mine), sum(o.failed for o in mine),
+                 sum(o.skipped for o in mine), sum(o.seconds for o in mine)), flush=True)
 
 
 def main():
     args = parse_args()
     build = Path(args.build).resolve()
+    try:
+        args.blender_exes = resolve_blenders(args, build)
+    except (blenders.BlenderError, subprocess.CalledProcessError) as err:
+        print("error: %s" % err)
+        print("0 passed, 1 failed")
+        return 1
     outcomes = []
     ctest = run_ctest(build, args.patterns, args.timeout, args.verbose)
     print_outcome(ctest)
     outcomes.append(ctest)
 
+    start = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="radiosity-tests-") as tmp:
         jobs = python_jobs(args, build, tmp)
         with concurrent.futures.ThreadPoolExecutor(max(1, args.jobs)) as pool:
-            futures = [pool.submit(run_unittest_file, name, cmd, json_out, args.timeout, args.verbose)
-                       for name, cmd, json_out in jobs]
-            for future in futures:  # in a fixed order, whatever finishes first
+            futures = [(label, pool.submit(run_unittest_file, name, cmd, json_out, args.timeout, args.verbose))
+                       for name, label, cmd, json_out in jobs]
+            for label, future in futures:  # in a fixed order, whatever finishes first
                 outcome = future.result()
+                outcome.blender = label
                 print_outcome(outcome)
                 outcomes.append(outcome)
+    print_blender_totals(outcomes, [label for label, _ in args.blender_exes])
+    print("Python test files: %.1f s wall (-j %d)" % (time.perf_counter() - start, args.jobs))
 
     passed = sum(o.passed for o in outcomes)
     failed = sum(o.failed for o in outcomes)

@@ -4,13 +4,16 @@ Background Blender has no window, so invoke falls back to the synchronous
 solve there. This test starts a second Blender with a window on a virtual X
 display (xvfb-run, Debian packages xvfb and libgl1-mesa-dri), invokes the
 operator in its 3D view and, in one run, sends ESC through the window's event
-queue (--enable-event-simulate). Skipped when xvfb-run is not installed.
+queue (--enable-event-simulate). Skipped when xvfb-run is not installed, and in
+bpy (Blender as a Python module, run through tools/blender_cli.py), which has no
+windows at all.
 """
 
 import json
 import os
 import shutil
 import subprocess
+import sys
 import unittest
 
 import bpy
@@ -21,6 +24,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 @unittest.skipIf(shutil.which("xvfb-run") is None, "xvfb-run not installed (apt-get install xvfb libgl1-mesa-dri)")
+@unittest.skipIf("blender_cli" in sys.modules, "bpy (Blender as a Python module) has no windows")
 class InteractiveSolveTest(unittest.TestCase):
     def run_window(self, scene, mode):
         cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x800x24", bpy.app.binary_path, "--factory-startup",

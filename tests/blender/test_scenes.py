@@ -22,6 +22,7 @@ sys.path.insert(0, os.path.abspath(SCENES_DIR))
 
 import build_scene  # noqa: E402
 import catalog  # noqa: E402
+import scene_kit as kit  # noqa: E402
 
 # The object each scene's camera must see, and that casts the shadow.
 SUBJECT = {"cube": "Cube", "office": "Table.Top", "full_office": "Table.Top",
@@ -129,7 +130,7 @@ class SceneBuildersTest(unittest.TestCase):
                     if "Principled BSDF" in nodes:
                         bsdf = nodes["Principled BSDF"]
                         rho = bsdf.inputs["Base Color"].default_value[:3]
-                        self.assertEqual(bsdf.inputs["Specular"].default_value, 0.0, mat.name)
+                        self.assertEqual(kit.principled_input(bsdf, "Specular").default_value, 0.0, mat.name)
                     else:   # Lambertian: a Diffuse BSDF (scene_kit.lambertian_material)
                         rho = next(n for n in nodes if n.type == 'BSDF_DIFFUSE').inputs["Color"].default_value[:3]
                     self.assertTrue(all(0 <= c < 1 for c in rho), mat.name)
