@@ -4,8 +4,8 @@
 set -euo pipefail
 
 packages=(
-  blender cmake g++ make pkg-config
-  python3 python3-dev python3-numpy python3-matplotlib
+  blender cmake g++ make pkg-config patchelf
+  python3 python3-dev python3-venv python3-numpy python3-matplotlib
   pybind11-dev libglm-dev libopenimageio-dev libembree-dev libtbb-dev
   libgtest-dev libbenchmark-dev
   xvfb libgl1-mesa-dri  # the interactive (modal, ESC) test runs Blender in a virtual display

@@ -31,7 +31,7 @@ def cache_key(blender, scene, width, height, samples, seed):
     return h.hexdigest()[:16]
 
 
-def cycles_reference(rad, blender, blend, addon, scene, settings, out_dir, cache_dir, verbose=False):
+def cycles_reference(metric, blender, blend, addon, scene, settings, out_dir, cache_dir, verbose=False):
     """Writes out_dir/cycles.exr (mean of the seeds); returns its path and the noise dict."""
     out_dir, cache_dir = pathlib.Path(out_dir), pathlib.Path(cache_dir)
     cache_dir.mkdir(parents=True, exist_ok=True)
@@ -45,13 +45,13 @@ def cycles_reference(rad, blender, blend, addon, scene, settings, out_dir, cache
                                    verbose)
     for c, s in zip(cached, seeds):
         shutil.copyfile(c, out_dir / ("cycles_seed%d.exr" % s))
-    images = [rad.read_image(str(c)) for c in cached]
+    images = [metric.read_image(str(c)) for c in cached]
     mean = np.mean(images, axis=0).astype(np.float32)
     path = out_dir / "cycles.exr"
-    rad.write_image(str(path), mean)
+    metric.write_image(str(path), mean)
     noise = dict(samples_per_seed=samples, seeds=len(seeds), dog=float("nan"), rms=float("nan"))
     if len(cached) >= 2:
-        d = rad.image_errors(str(cached[0]), str(cached[1]))
+        d = metric.image_errors(str(cached[0]), str(cached[1]))
         # The mean of k renders has 1/sqrt(k) of one render's noise d / sqrt(2).
         scale = 1.0 / np.sqrt(2.0 * len(cached))
         noise.update(dog=d["dog"] * scale, rms=d["rms"] * scale)

@@ -136,7 +136,7 @@ def match_sizes(rad, scene, study, known):
         study.name, target, ", ".join("%s %d" % (o, r["leaves"]) for o, r in study.comparison.items())))
 
 
-def render_all(rad, study, settings, blender, addon, cache_dir, verbose):
+def render_all(metric, study, settings, blender, addon, cache_dir, verbose):
     import references
     s = settings
     solutions = []
@@ -154,7 +154,7 @@ def render_all(rad, study, settings, blender, addon, cache_dir, verbose):
                                study.dir / "render_jobs.json", verbose)
     log("  %-11s rendered %d snapshots (%.0f s)" % (study.name, len(solutions), time.perf_counter() - start))
     start = time.perf_counter()
-    _, study.noise = references.cycles_reference(rad, blender, study.blend, addon, study.name, s,
+    _, study.noise = references.cycles_reference(metric, blender, study.blend, addon, study.name, s,
                                                  study.dir / "images", cache_dir, verbose)
     log("  %-11s Cycles reference (%d x %d samples, %.0f s): noise DoG %.2e, RMS %.2e" % (
         study.name, s["reference_seeds"], s["reference_samples"], time.perf_counter() - start,
@@ -173,34 +173,34 @@ def render_all(rad, study, settings, blender, addon, cache_dir, verbose):
     log("  %-11s Cycles bakes: %d (%.0f s)" % (study.name, len(study.bake_rows), time.perf_counter() - start))
 
 
-def exposure(rad, study, exr, reference="cycles"):
+def exposure(metric, study, exr, reference="cycles"):
     """Signed exposure error of a snapshot against the path-traced reference:
     mean linear luminance over the reference's, minus 1, emitter pixels left out
     (tests/blender/image_agreement.py, the measure of the agreement tests)."""
-    return image_agreement.compare(rad.read_image(str(exr)), rad.read_image(str(study.image_path(reference))),
+    return image_agreement.compare(metric.read_image(str(exr)), metric.read_image(str(study.image_path(reference))),
                                    np.load(study.mask_path))["exposure"]
 
 
-def score_all(rad, study):
+def score_all(metric, study):
     refined = str(study.image_path("refined"))
     cycles = str(study.image_path("cycles"))
     filtered = {r["tag"] for r in study.comparison.values()} | {"refined"}
     for row in study.rows + study.bake_rows:
         exr = str(study.image_path(row["tag"]))
         out = str(study.image_path(row["tag"] + "_dog")) if row["tag"] in filtered else None
-        a = rad.image_errors(exr, refined, filtered_output=out)
-        b = rad.image_errors(exr, cycles)
+        a = metric.image_errors(exr, refined, filtered_output=out)
+        b = metric.image_errors(exr, cycles)
         row.update(dog_refined=a["dog"], rms_refined=a["rms"], dog_cycles=b["dog"], rms_cycles=b["rms"],
-                   exposure_cycles=exposure(rad, study, exr),
+                   exposure_cycles=exposure(metric, study, exr),
                    image=str(pathlib.Path(exr).relative_to(study.dir.parent.parent)))
     # The reference solution against the path-traced render: the floor of the Cycles curves.
-    study.refined_vs_cycles = dict(rad.image_errors(refined, cycles), exposure=exposure(rad, study, refined))
-    rad.image_errors(cycles, refined, filtered_output=str(study.image_path("cycles_dog")))
+    study.refined_vs_cycles = dict(metric.image_errors(refined, cycles), exposure=exposure(metric, study, refined))
+    metric.image_errors(cycles, refined, filtered_output=str(study.image_path("cycles_dog")))
     # The reference's own exposure noise: its seeds differ by sqrt(2) times one
     # render's noise, the mean of k seeds has 1/sqrt(k) of it (as references.py).
     seeds = sorted(study.dir.joinpath("images").glob("cycles_seed*.exr"))
     if len(seeds) >= 2:
-        d = exposure(rad, study, seeds[0], reference=seeds[1].stem)
+        d = exposure(metric, study, seeds[0], reference=seeds[1].stem)
         study.noise["exposure"] = abs(d) / math.sqrt(2.0 * len(seeds))
     else:
         study.noise["exposure"] = float("nan")
@@ -228,6 +228,8 @@ def main():
     build = (ROOT / args.build).resolve() if not pathlib.Path(args.build).is_absolute() else pathlib.Path(args.build)
     addon = str(build / "addon")
     sys.path.insert(0, str(build / "addon" / "radiosity"))
+    sys.path.insert(0, str(build / "study"))   # _image_metric, the study-only module
+    import _image_metric as metric
     import _radiosity as rad
     out = pathlib.Path(args.out).resolve() if args.out else build / "bench"
     out.mkdir(parents=True, exist_ok=True)
@@ -246,8 +248,8 @@ def main():
     solve_seconds = time.perf_counter() - started
     log("== rendering, references, Cycles bakes")
     for st in studies:
-        render_all(rad, st, settings, args.blender, addon, out / "cache", args.verbose)
-        score_all(rad, st)
+        render_all(metric, st, settings, args.blender, addon, out / "cache", args.verbose)
+        score_all(metric, st)
     write_csv(out / "study.csv", studies)
     import study_figures
     import study_plots
@@ -255,7 +257,7 @@ def main():
     for stale in out.glob("study_compare_*.png"):   # scenes of an earlier run in another mode
         stale.unlink()
     plots = study_plots.plot_all(studies, out)
-    figures = study_figures.comparison_figures(rad, studies, out)
+    figures = study_figures.comparison_figures(metric, studies, out)
     study_report.write(out / "report.md", studies, settings, plots, figures,
                        dict(total=time.perf_counter() - started, solving=solve_seconds))
     log("== study done in %.0f s: %s, %s, %d plots, %d figures"

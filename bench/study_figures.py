@@ -20,7 +20,7 @@ def display(rgb):
     return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1 / 2.4) - 0.055)
 
 
-def comparison_figures(rad, studies, out):
+def comparison_figures(metric, studies, out):
     paths = []
     for st in studies:
         rows = [("refined reference (%s, %d leaves), exposure %+.1f %%"
@@ -32,11 +32,11 @@ def comparison_figures(rad, studies, out):
                              % (oracle, r["leaves"], r["dog_refined"], 100 * r["exposure_cycles"]), r["tag"]))
         rows.append(("Cycles path traced (%d x %d spp)" % (st.noise["seeds"], st.noise["samples_per_seed"]),
                      "cycles"))
-        ref_dog = rad.read_image(str(st.image_path("refined_dog")))[:, :, 0]
+        ref_dog = metric.read_image(str(st.image_path("refined_dog")))[:, :, 0]
         scale = float(np.percentile(np.abs(ref_dog), 99.5)) or 1.0
         fig, axes = plt.subplots(len(rows), 3, figsize=(12, 3.0 * len(rows)), squeeze=False)
         for i, (label, tag) in enumerate(rows):
-            img = display(rad.read_image(str(st.image_path(tag))))
+            img = display(metric.read_image(str(st.image_path(tag))))
             h, w, _ = img.shape
             axes[i][0].imshow(img)
             axes[i][0].set_title(label, fontsize=8)
@@ -48,7 +48,7 @@ def comparison_figures(rad, studies, out):
                 axes[i][1].set_title("mesh: %d edge pieces seen" % len(segs), fontsize=8)
             else:
                 axes[i][1].set_title("(no mesh)", fontsize=8)
-            dog = rad.read_image(str(st.image_path(tag + "_dog")))[:, :, 0]
+            dog = metric.read_image(str(st.image_path(tag + "_dog")))[:, :, 0]
             axes[i][2].imshow(dog, cmap="gray", vmin=-scale, vmax=scale)
             axes[i][2].set_title("centre-surround filtered brightness", fontsize=8)
             for ax in axes[i]:

@@ -145,8 +145,8 @@ def write(path, studies, settings, plots, figures, seconds):
     s = settings
     sig = None
     try:
-        import _radiosity
-        sig = _radiosity.edge_filter_sigmas(s["width"])
+        import _image_metric
+        sig = _image_metric.edge_filter_sigmas(s["width"])
     except ImportError:
         pass
     out = ["# Speed-accuracy study (source Chapter 7)", "",

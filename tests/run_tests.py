@@ -3,8 +3,9 @@
 
 Three kinds of tests, run in this order:
   ctest           the C++ unit tests registered with CTest in the build dir
-  native/test_*   unittest files for the `_radiosity` module, run by /usr/bin/python3
-                  with build/addon/radiosity on sys.path (no Blender)
+  native/test_*   unittest files for the `_radiosity` module (and the study's
+                  `_image_metric`), run by /usr/bin/python3 with build/addon/radiosity
+                  and build/study on sys.path (no Blender)
   blender/test_*  unittest files run inside each Blender given (--blender, repeatable:
                   3.4, 4.5, 5.0 of tools/blenders.py, installed when missing, or a path),
                   `blender --background --factory-startup`, one process per file,
@@ -199,7 +200,7 @@ def blender_crash_log(output):
 
 
 def native_command(python, build, testfile, json_out, patterns):
-    return [python, str(RUNNER), "--path", str(build / "addon" / "radiosity"),
+    return [python, str(RUNNER), "--path", str(build / "addon" / "radiosity"), "--path", str(build / "study"),
             *pattern_options(patterns), str(testfile), json_out]
 
 

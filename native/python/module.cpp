@@ -14,5 +14,4 @@ PYBIND11_MODULE(_radiosity, m) {
   radiosity::python::bind_kernels(m);
   radiosity::python::bind_visibility(m);
   radiosity::python::bind_solver(m);
-  radiosity::python::bind_image_metric(m);
 }

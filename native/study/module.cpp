@@ -1,6 +1,9 @@
-// Python access to the image-quality measure (core/image_metric.h): reading and
-// writing linear images, brightness, the centre-surround filter, eq. 24, and
-// one call that scores a snapshot against a reference from their files.
+// The study-only module `_image_metric` (bench/, tests): the image-quality
+// measure (study/image_metric.h) for Python: reading and writing linear images,
+// brightness, the centre-surround filter, eq. 24, and one call that scores a
+// snapshot against a reference from their files. It is built beside the add-on,
+// never shipped in it: OpenImageIO, which it needs, is no dependency of the
+// solver (`_radiosity`).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -8,8 +11,7 @@
 #include <optional>
 #include <string>
 
-#include "core/image_metric.h"
-#include "python/bindings.h"
+#include "study/image_metric.h"
 #include "python/numpy_input.h"
 
 namespace py = pybind11;
@@ -82,8 +84,6 @@ py::dict image_errors(const std::string& test, const std::string& reference, con
   return d;
 }
 
-}  // namespace
-
 void bind_image_metric(py::module_& m) {
   m.def("read_image", [](const std::string& path) {
     const RgbImage img = read_rgb_image(path);
@@ -138,4 +138,10 @@ void bind_image_metric(py::module_& m) {
         "sigmas used. filtered_output: also write test's filtered brightness there.");
 }
 
+}  // namespace
 }  // namespace radiosity::python
+
+PYBIND11_MODULE(_image_metric, m) {
+  m.doc() = "Image-quality measure of the speed-accuracy study (Section 6.2.3), with OpenImageIO";
+  radiosity::python::bind_image_metric(m);
+}

@@ -1,4 +1,4 @@
-#include "core/image_metric.h"
+#include "study/image_metric.h"
 
 #include <OpenImageIO/imageio.h>
 

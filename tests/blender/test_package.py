@@ -1,0 +1,100 @@
+"""The zips of `make package` (tools/package.py), installed as a user would, in this Blender.
+
+Each test starts a second Blender of the same kind (bpy.app.binary_path) with a
+clean, empty user folder (BLENDER_USER_RESOURCES, and BLENDER_USER_SCRIPTS for
+3.x), installs a zip through Blender's own installer, enables it, builds the
+bundled cube scene (scenes/), solves it and reports, as one JSON line: where
+the add-on and its compiled module were loaded from, which Embree and TBB the
+process mapped, and the baked attribute's values. The tests assert that all of
+it came from the installed package, not from the build tree or the system.
+
+- The extension zip (Blender 4.2+): bpy.ops.extensions.package_install_files
+  into the "user_default" repository. Skipped in Blenders without extensions.
+- The legacy add-on zip: bpy.ops.preferences.addon_install, in every Blender.
+"""
+
+import json
+import os
+import pathlib
+import subprocess
+import tempfile
+import unittest
+
+import bpy
+
+import radiosity
+
+BUILD = pathlib.Path(radiosity.__file__).resolve().parents[2]   # <build>/addon/radiosity/__init__.py
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+HERE = pathlib.Path(__file__).resolve().parent
+
+
+def package_zip(kind):
+    """The zip of `kind` ("extension" or "legacy") in the build folder."""
+    import tomllib
+    manifest = tomllib.loads((BUILD / "addon" / "radiosity" / "blender_manifest.toml").read_text())
+    stem = "%s-%s-%s" % (manifest["id"], manifest["version"], "legacy_" if kind == "legacy" else "")
+    path = BUILD / ("%s%s.zip" % (stem, "_".join(manifest["platforms"]).replace("-", "_")))
+    if not path.exists():
+        raise AssertionError("%s not found: run `make package` (make test does)" % path)
+    return path
+
+
+def has_extensions():
+    return hasattr(bpy.ops, "extensions") and "package_install_files" in dir(bpy.ops.extensions)
+
+
+class InstalledPackageTest(unittest.TestCase):
+    def install_and_solve(self, kind):
+        """Run install_and_solve.py in a fresh Blender with an empty user folder; its report."""
+        with tempfile.TemporaryDirectory(prefix="radiosity-user-") as user:
+            env = dict(os.environ, BLENDER_USER_RESOURCES=user, BLENDER_USER_SCRIPTS=os.path.join(user, "scripts"),
+                       BLENDER_USER_CONFIG=os.path.join(user, "config"))
+            cmd = [bpy.app.binary_path, "-b", "--factory-startup", "--python-exit-code", "1",
+                   "--python", str(HERE / "install_and_solve.py"), "--",
+                   kind, str(package_zip(kind)), str(ROOT / "scenes")]
+            proc = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600,
+                                  stdin=subprocess.DEVNULL)
+            log = proc.stdout[-3000:] + proc.stderr[-3000:]
+            lines = [line for line in proc.stdout.splitlines() if line.startswith("RESULT ")]
+            self.assertEqual(proc.returncode, 0, log)
+            self.assertTrue(lines, log)
+            report = json.loads(lines[-1][len("RESULT "):])
+            report["user"] = os.path.realpath(user)
+            return report
+
+    def check(self, report):
+        user = report["user"]
+        inside = lambda path: os.path.realpath(path).startswith(user + os.sep)  # noqa: E731
+        self.assertTrue(inside(report["addon_file"]), report["addon_file"])
+        self.assertTrue(inside(report["module_file"]), report["module_file"])
+        self.assertNotIn(str(BUILD), report["module_file"])
+        # Embree and TBB mapped from the package's libs/, not from the system.
+        for name in ("libembree3", "libtbb"):
+            mapped = [p for p in report["libraries"] if os.path.basename(p).startswith(name + ".so")]
+            self.assertTrue(mapped, (name, report["libraries"]))
+            for path in mapped:
+                self.assertTrue(inside(path), path)
+        self.assertEqual(report["status"], "Converged")
+        self.assertEqual(report["results"], 8)
+        self.assertGreater(report["elements"], 8)
+        # The baked attribute: radiance on every result mesh, finite, not all dark.
+        self.assertEqual(report["attributes"], report["results"])
+        self.assertTrue(report["finite"])
+        self.assertGreater(report["max_radiance"], 0.1)
+        self.assertGreaterEqual(report["min_radiance"], 0.0)
+
+    @unittest.skipUnless(has_extensions(), "this Blender has no extensions (4.2+)")
+    def test_extension_zip(self):
+        report = self.install_and_solve("extension")
+        self.assertTrue(report["module"].startswith("bl_ext.user_default."), report["module"])
+        self.check(report)
+
+    def test_legacy_zip(self):
+        report = self.install_and_solve("legacy")
+        self.assertEqual(report["module"], "radiosity")
+        self.check(report)
+
+
+if __name__ == "__main__":
+    unittest.main()
