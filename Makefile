@@ -2,7 +2,12 @@
 # each installs what is missing, builds, then does its job.
 BUILD      ?= build
 JOBS       ?= $(shell nproc)
-BLENDER    ?= blender
+# Blenders by name (tools/blenders.py: 3.4 is Debian's, 4.5 and 5.0 are bpy from PyPI,
+# installed into $(BUILD)/blenders on first use) or by path. BLENDER runs demo,
+# scenes and bench (and is asked for the Python version to build for); `make test`
+# runs tests/blender in each of BLENDERS, e.g. `make test BLENDERS=3.4` for a quick run.
+BLENDER    ?= 3.4
+BLENDERS   ?= 3.4 4.5 5.0
 PYTHON     ?= /usr/bin/python3
 SCENE      ?= office
 CMAKE_ARGS ?=
@@ -11,7 +16,11 @@ ifdef CI
 CMAKE_ARGS += -DRADIOSITY_WERROR=ON
 endif
 
-.PHONY: all deps configure build test unit demo scenes package bench figures clean
+.PHONY: all deps configure build test unit demo scenes package bench figures clean blenders
+
+# The command that runs $(BLENDER), installing it first if it is a bpy not yet installed.
+BLENDER_EXE = "$$($(PYTHON) tools/blenders.py install --build $(BUILD) $(BLENDER) >&2 && \
+                  $(PYTHON) tools/blenders.py executable --build $(BUILD) $(BLENDER))"
 
 all: build
 
@@ -20,29 +29,34 @@ deps:
 
 # The module is built for the Python of $(BLENDER), so CMake asks that Blender.
 $(BUILD)/CMakeCache.txt: | deps
-	cmake -S . -B $(BUILD) -DBLENDER_EXECUTABLE="$$(command -v $(BLENDER))" $(CMAKE_ARGS)
+	cmake -S . -B $(BUILD) -DBLENDER_EXECUTABLE="$$(command -v $(BLENDER_EXE))" $(CMAKE_ARGS)
 
 configure: $(BUILD)/CMakeCache.txt
 
 build: deps configure
 	@cmake --build $(BUILD) -j $(JOBS)
 
-# Unit tests (CTest), Python tests of the native module and headless Blender tests,
-# with one summary line at the end.
-test: build
-	@$(PYTHON) tests/run_tests.py --build $(BUILD) --blender $(BLENDER)
+# Unit tests (CTest), Python tests of the native module and the packages, and the
+# headless Blender tests in each of $(BLENDERS), with one summary line at the end.
+test: build package blenders
+	@$(PYTHON) tests/run_tests.py --build $(BUILD) $(foreach b,$(BLENDERS),--blender $(b))
+
+# Installs each bpy of $(BLENDERS) that is missing (pinned; a no-op once there).
+blenders:
+	@$(PYTHON) tools/blenders.py install --build $(BUILD) $(BLENDERS)
 
 scenes: build
-	@$(PYTHON) scenes/build_all.py --build $(BUILD) --blender $(BLENDER)
+	@$(PYTHON) scenes/build_all.py --build $(BUILD) --blender $(BLENDER_EXE)
 
 demo: build
-	@$(PYTHON) scenes/demo.py --build $(BUILD) --blender $(BLENDER) --scene $(SCENE)
+	@$(PYTHON) scenes/demo.py --build $(BUILD) --blender $(BLENDER_EXE) --scene $(SCENE)
 
+# The Blender 4.2+ extension zip and the legacy add-on zip (tools/package.py).
 package: build
-	@cmake --build $(BUILD) --target package
+	@$(PYTHON) tools/package.py --build $(BUILD)
 
 bench: build
-	@$(PYTHON) bench/run_bench.py --build $(BUILD) --blender $(BLENDER) $(if $(QUICK),--quick,)
+	@$(PYTHON) bench/run_bench.py --build $(BUILD) --blender $(BLENDER_EXE) $(if $(QUICK),--quick,)
 
 # Section 4.3.1 of the source (Figures 22-25): F and |grad F| behind an occluder,
 # as PNG images in $(BUILD)/figures (FIGURE_SIZE pixels square).
