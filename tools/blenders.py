@@ -72,8 +72,11 @@ def installed(build, name):
 
 
 def install(build, name, log=print):
-    """Make Blender `name` runnable; a no-op when it already is."""
+    """Make Blender `name` runnable; a no-op when it already is (but for its launcher,
+    rewritten so that a change to it reaches existing environments)."""
     if installed(build, name):
+        if BLENDERS.get(name):
+            write_launcher(env_dir(build, name), name)
         return
     if name not in BLENDERS:
         raise BlenderError("no Blender at %r (names known: %s)" % (name, ", ".join(BLENDERS)))
