@@ -2,9 +2,9 @@
 
     blender -b --factory-startup --python install_and_solve.py -- extension|legacy ZIP SCENES_DIR
 
-Installs ZIP with Blender's installer (extension: into the "user_default"
-repository; legacy: the add-on installer), enables it, builds the bundled cube
-scene, solves it and prints one line "RESULT <json>".
+Builds the bundled cube scene, installs ZIP with Blender's installer (extension:
+into the "user_default" repository; legacy: the add-on installer), enables it,
+solves and prints one line "RESULT <json>".
 """
 
 import importlib
@@ -44,14 +44,16 @@ def mapped_libraries():
 
 
 def main():
-    module = install()
-    package = importlib.import_module(module)
     sys.path.insert(0, SCENES)
     import build_scene
     import scene_kit
 
+    # The scene first: starting an empty file resets the preferences, add-ons included.
     scene = scene_kit.empty_file()
     build_scene.build("cube", scene)
+    host_libraries = mapped_libraries()   # Blender's own, before the add-on loads
+    module = install()
+    package = importlib.import_module(module)
     scene.radiosity.quality = 0.3
     assert bpy.ops.radiosity.solve() == {'FINISHED'}
     results = [o for o in scene.objects if o.get("radiosity_result")]
@@ -66,7 +68,7 @@ def main():
     native = sys.modules[module + "._radiosity"]
     print("RESULT " + json.dumps({
         "module": module, "addon_file": package.__file__, "module_file": native.__file__,
-        "libraries": mapped_libraries(), "status": scene.radiosity.stats.status,
+        "host_libraries": host_libraries, "libraries": mapped_libraries(), "status": scene.radiosity.stats.status,
         "elements": scene.radiosity.stats.elements, "results": len(results),
         "attributes": sum(1 for o in results if "Radiosity" in o.data.color_attributes),
         "finite": bool(np.all(np.isfinite(values))), "max_radiance": float(values.max(initial=0.0)),
