@@ -11,12 +11,16 @@ BLENDERS   ?= 3.4 4.5 5.0
 PYTHON     ?= /usr/bin/python3
 SCENE      ?= office
 CMAKE_ARGS ?=
+# PORTABLE=ON: the shipped module is built for manylinux_2_28 with zig (its tools and
+# static Embree and TBB built once into $(BUILD)/portable-deps, about 15 minutes the
+# first time); OFF: a quick local GCC build with Debian's libraries bundled.
+PORTABLE   ?= ON
 MAKEFLAGS  += --no-print-directory
 ifdef CI
 CMAKE_ARGS += -DRADIOSITY_WERROR=ON
 endif
 
-.PHONY: all deps configure build test unit demo scenes package bench figures clean blenders
+.PHONY: all deps portable configure build test unit demo scenes package bench figures clean blenders
 
 # The command that runs $(BLENDER), installing it first if it is a bpy not yet installed.
 BLENDER_EXE = "$$($(PYTHON) tools/blenders.py install --build $(BUILD) $(BLENDER) >&2 && \
@@ -28,12 +32,19 @@ deps:
 	@bash .ci/install-deps.sh
 
 # The module is built for the Python of $(BLENDER), so CMake asks that Blender.
-$(BUILD)/CMakeCache.txt: | deps
-	cmake -S . -B $(BUILD) -DBLENDER_EXECUTABLE="$$(command -v $(BLENDER_EXE))" $(CMAKE_ARGS)
+$(BUILD)/CMakeCache.txt: | deps portable
+	cmake -S . -B $(BUILD) -DBLENDER_EXECUTABLE="$$(command -v $(BLENDER_EXE))" \
+	      -DRADIOSITY_PORTABLE=$(PORTABLE) $(CMAKE_ARGS)
 
 configure: $(BUILD)/CMakeCache.txt
 
-build: deps configure
+# The portable build's compiler and libraries (tools/portable_deps.py; a no-op once made).
+portable: deps
+ifeq ($(PORTABLE),ON)
+	@$(PYTHON) tools/portable_deps.py --build $(BUILD)
+endif
+
+build: deps portable configure
 	@cmake --build $(BUILD) -j $(JOBS)
 
 # Unit tests (CTest), Python tests of the native module and the packages, and the
