@@ -44,6 +44,13 @@ RTCDevice shared_embree_device() {
   static RTCDevice device = [] {
     RTCDevice d = rtcNewDevice("threads=0");
     if (!d) throw std::runtime_error("Embree: cannot create a device");
+    // The link's own faces are skipped by a context filter; an Embree built
+    // without filter functions ignores it silently and shadows every folded
+    // face: refuse it.
+    if (rtcGetDeviceProperty(d, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED) == 0) {
+      rtcReleaseDevice(d);
+      throw std::runtime_error("Embree was built without filter functions (EMBREE_FILTER_FUNCTION=OFF); the solver needs them");
+    }
     return d;
   }();
   return device;

@@ -1,9 +1,13 @@
 // Python access to occluded form factors (Section 4.3): visible_form_factor(),
-// exact (visible polygon, exact gradient) or sampled (shadow rays through Embree).
+// exact (visible polygon, exact gradient) or sampled (shadow rays through Embree),
+// with the link's own faces left out as solve() leaves them out (shaft culling in
+// exact mode, Embree's per-query ray filter in sampled mode).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -61,6 +65,36 @@ std::vector<Triangle> read_triangles(const py::handle& object, const std::string
   return triangles;
 }
 
+// The face of each occluder triangle: (m,) integers, or None for each its own.
+std::vector<std::uint32_t> read_faces(const py::handle& object, std::size_t count) {
+  std::vector<std::uint32_t> face(count);
+  if (object.is_none()) {
+    for (std::size_t t = 0; t < count; ++t) face[t] = static_cast<std::uint32_t>(t);
+    return face;
+  }
+  const auto a = read_array_of<std::int64_t>(object, "faces", {static_cast<py::ssize_t>(count)});
+  for (std::size_t t = 0; t < count; ++t) {
+    const std::int64_t f = a.data()[t];
+    if (f < 0 || f >= static_cast<std::int64_t>(kNoFace))
+      throw std::invalid_argument("faces[" + std::to_string(t) + "] = " + std::to_string(f) + " is not a face id");
+    face[t] = static_cast<std::uint32_t>(f);
+  }
+  return face;
+}
+
+// The link's own faces (receiver's, emitter's): at most two ids.
+std::array<std::uint32_t, 2> read_own_faces(const py::handle& object) {
+  std::array<std::uint32_t, 2> own{kNoFace, kNoFace};
+  const auto a = read_array_of<std::int64_t>(object, "own_faces", {-1});
+  if (a.size() > 2) throw std::invalid_argument("own_faces holds at most two faces (receiver's, emitter's)");
+  for (py::ssize_t k = 0; k < a.size(); ++k) {
+    if (a.data()[k] < 0 || a.data()[k] >= static_cast<std::int64_t>(kNoFace))
+      throw std::invalid_argument("own_faces[" + std::to_string(k) + "] is not a face id");
+    own[static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(a.data()[k]);
+  }
+  return own;
+}
+
 py::array_t<double> to_numpy(const std::vector<dvec3>& points) {
   py::array_t<double> out({static_cast<py::ssize_t>(points.size()), py::ssize_t{3}});
   auto w = out.mutable_unchecked<2>();
@@ -75,12 +109,15 @@ void bind_visibility(py::module_& m) {
   m.def(
       "visible_form_factor",
       [](const py::handle& point, const py::handle& normal, const py::handle& emitter,
-         const py::handle& occluders, const std::string& mode, int rays) {
+         const py::handle& occluders, const std::string& mode, int rays, const py::handle& faces,
+         const py::handle& own_faces) {
         const dvec3 r = read_vec3(point, "point");
         const dvec3 n = read_unit_vec3(normal, "normal");
         const std::vector<dvec3> polygon = read_polygon(emitter, "emitter");
         require_planar_convex(polygon, "emitter");
         const std::vector<Triangle> triangles = read_triangles(occluders, "occluders");
+        const std::vector<std::uint32_t> face = read_faces(faces, triangles.size());
+        const std::array<std::uint32_t, 2> own = read_own_faces(own_faces);
         if (mode != "exact" && mode != "sampled")
           throw std::invalid_argument("mode must be 'exact' or 'sampled', got '" + mode + "'");
         if (rays < 1 || rays > (1 << 24))
@@ -89,24 +126,33 @@ void bind_visibility(py::module_& m) {
         {
           py::gil_scoped_release release;
           if (mode == "exact") {
-            result = visible_form_factor_gradient(r, n, polygon, triangles);
+            // As shaft culling does for a link: its own faces are no candidates.
+            std::vector<Triangle> others;
+            for (std::size_t t = 0; t < triangles.size(); ++t)
+              if (face[t] != own[0] && face[t] != own[1]) others.push_back(triangles[t]);
+            result = visible_form_factor_gradient(r, n, polygon, others);
           } else {
-            const RayScene scene(triangles);
+            // Every triangle goes to Embree, which must skip the own faces itself.
+            const RayScene scene(triangles, face);
             SampledVisibilityOptions options;
             options.rays = rays;
-            result = sampled_form_factor_gradient(r, n, polygon, scene, options);
+            result = sampled_form_factor_gradient(r, n, polygon, scene, options, own[0], own[1]);
           }
         }
         return py::make_tuple(result.value, to_numpy(result.gradient));
       },
       py::arg("point"), py::arg("normal"), py::arg("emitter"), py::arg("occluders"),
-      py::arg("mode") = "exact", py::arg("rays") = 64,
+      py::arg("mode") = "exact", py::arg("rays") = 64, py::arg("faces") = py::none(),
+      py::arg("own_faces") = py::tuple(),
       "(F, grad F) of the part of `emitter` ((n, 3) convex planar polygon,\n"
       "counter-clockwise about its front normal) visible from `point` past\n"
       "`occluders` ((m, 3, 3) triangles, m may be 0).\n"
       "mode='exact': the visible polygon (Section 4.3) and its exact gradient.\n"
       "mode='sampled': `rays` stratified shadow rays (Embree) give the visible\n"
-      "fraction; F and the unoccluded gradient are scaled by it.");
+      "fraction; F and the unoccluded gradient are scaled by it.\n"
+      "faces: (m,) the input face of each occluder (default: each its own);\n"
+      "own_faces: up to two faces (the receiver's, the emitter's) that never shadow,\n"
+      "as in solve(): left out in exact mode, skipped by Embree's ray filter in sampled mode.");
   m.def(
       "visible_polygon",
       [](const py::handle& point, const py::handle& normal, const py::handle& emitter,
