@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cmath>
 #include <vector>
 
@@ -19,6 +20,11 @@ constexpr double kFootGap = 0.01;           // of the touching face's diameter
 constexpr double kCoincident = 1e-5;        // of the larger face's diameter
 constexpr double kCoincidentScene = 1e-6;   // of the scene's diameter
 constexpr double kThinnest = 1e-4;          // of the cut face's diameter
+// A face smaller than this share of the cut face's diameter (a chair leg on a
+// floor) is not cut around unless it emits: what could leak under it is
+// negligible, and its cuts, run across the pieces they cross, multiplied the
+// floor's pieces (full_office: 2.2 times the patches).
+constexpr double kSmallest = 0.02;
 
 double cross2(const dvec2& a, const dvec2& b) { return a.x * b.y - a.y * b.x; }
 
@@ -150,7 +156,12 @@ struct Contact {
   double gap = 0.0;                  // of a cover: the farthest of its corners from P's plane
   bool coincident = false;           // a cover lying in P's plane
   bool meets = false;                // cuts[0] is where Q meets P's plane
+  bool crosses = false;              // Q passes through P's plane there (not only rests on it)
 };
+
+bool emits(const Patch& q) {
+  return luminance(q.sides[0].emission) > 0.0 || luminance(q.sides[1].emission) > 0.0;
+}
 
 Contact contact_of(const Frame& f, double dp, const Patch& q, double dq, double scene_diameter) {
   Contact out;
@@ -166,6 +177,7 @@ Contact contact_of(const Frame& f, double dp, const Patch& q, double dq, double 
   const double touch = std::max(kCoincident * std::max(dp, dq), kCoincidentScene * scene_diameter);
   if (std::abs(glm::dot(f.n, q.normal)) >= kParallelCosine) {
     if (farthest > kCoverGap * std::min(dp, dq)) return out;
+    if (dq < kSmallest * dp && !emits(q)) return out;
     std::vector<dvec2> outline;
     for (int i = 0; i < q.corner_count; ++i) outline.push_back(f.to2(q.corners[static_cast<size_t>(i)]));
     if (signed_area(outline) < 0.0) std::reverse(outline.begin(), outline.end());
@@ -178,7 +190,8 @@ Contact contact_of(const Frame& f, double dp, const Patch& q, double dq, double 
   // Where Q meets P's plane: the segment it crosses it along, or the edge
   // that rests on it.
   std::vector<dvec3> points;
-  if (lo < -touch && hi > touch) {
+  out.crosses = lo < -touch && hi > touch;
+  if (out.crosses) {
     for (int i = 0; i < q.corner_count; ++i) {
       const int j = (i + 1) % q.corner_count;
       const dvec3& a = q.corners[static_cast<size_t>(i)];
@@ -201,6 +214,7 @@ Contact contact_of(const Frame& f, double dp, const Patch& q, double dq, double 
       const double d = glm::length(points[i] - points[j]);
       if (d > best) best = d, a = i, b = j;
     }
+  if (best < kSmallest * dp && !emits(q)) return out;
   out.cuts.push_back({f.to2(points[a]), f.to2(points[b])});
   out.meets = true;
   return out;
@@ -227,6 +241,7 @@ struct Features {
   };
   struct Meeting {
     Segment segment;
+    bool crosses;  // the other face passes through this one there
   };
   std::vector<Cover> covers;
   std::vector<Meeting> meetings;
@@ -273,12 +288,10 @@ void mark_discontinuities(Piece& piece, const Polygon2& polygon, const Polygon2&
     }
     if (on_line) piece.corner_class[i] = static_cast<std::uint32_t>(signature | 1u << 31);
     // Edges along the outline of a cover some gap away, and along a line
-    // inside the face where another face meets it (a sample a millionth from
+    // where another face passes through this one (a sample a millionth from
     // that face sees it edge-on: projecting it to find what it hides is then
-    // ill-conditioned, a plate through a wall let 1e-9 of the light behind the
-    // wall through; and the oracles pass over samples touching an emitter, so
-    // the shadow at a box's foot was not refined). Not along the face's own
-    // edges, where walls meet floors: that is the usual contact (MATH.md s3).
+    // ill-conditioned, and a plate through a wall let 1e-9 of the light behind
+    // the wall through). Not along the face's own edges.
     const dvec2 w = polygon[(i + 1) % n].p;
     bool own_edge = false;
     for (size_t e = 0; e < whole.size() && !own_edge; ++e) {
@@ -286,7 +299,7 @@ void mark_discontinuities(Piece& piece, const Polygon2& polygon, const Polygon2&
       own_edge = distance_to_segment(v, edge) <= near && distance_to_segment(w, edge) <= near;
     }
     for (const Features::Meeting& m : features.meetings) {
-      if (!own_edge && distance_to_segment(v, m.segment) <= near && distance_to_segment(w, m.segment) <= near)
+      if (m.crosses && !own_edge && distance_to_segment(v, m.segment) <= near && distance_to_segment(w, m.segment) <= near)
         piece.edge_inset[i] = std::max(piece.edge_inset[i], static_cast<float>(10.0 * thinnest));
     }
     for (const Features::Cover& cover : features.covers) {
@@ -407,7 +420,7 @@ void mesh_contacts(Scene& scene) {
       for (std::uint32_t q : near) {
         Contact c = contact_of(f, diameter[p], patches[q], diameter[q], scene.diameter);
         cuts.insert(cuts.end(), c.cuts.begin(), c.cuts.end());
-        if (c.meets) features.meetings.push_back({c.cuts[0]});
+        if (c.meets) features.meetings.push_back({c.cuts[0], c.crosses});
         if (!c.cover_outline.empty()) {
           features.covers.push_back({c.cover_outline, c.gap > std::max(touch_p, kCoincident * diameter[p]) ? c.gap : 0.0});
           if (c.coincident) coincident.emplace_back(q, std::move(c.cover_outline));
@@ -481,8 +494,8 @@ void mesh_contacts(Scene& scene) {
       if (target < 0) continue;
       target = resolve(target);
       Piece& into = *flat[static_cast<size_t>(target)];
-      size_t owner_patch = 0;
-      while (first_piece[owner_patch + 1] <= static_cast<size_t>(target)) ++owner_patch;
+      const size_t owner_patch = static_cast<size_t>(
+          std::upper_bound(first_piece.begin(), first_piece.end(), static_cast<size_t>(target)) - first_piece.begin() - 1);
       const bool same_facing = glm::dot(patches[p].normal, patches[owner_patch].normal) > 0.0;
       for (size_t s = 0; s < 2; ++s) {
         const PatchSide& side = piece.sides[s];

@@ -58,8 +58,8 @@ struct Patch {
   // same side of it (class 0: no such line through the corner); samples on
   // an edge along the outline of a cover a gap g away move 4 g into the patch
   // (the cover's penumbra there is only about g wide), on a cut where a face
-  // meets it inside its outline 1e-3 of its diameter (so they do not see that
-  // face edge-on).
+  // passes through it 1e-3 of its diameter (so they do not see that face
+  // edge-on).
   std::array<std::uint32_t, 4> corner_class{};
   std::array<float, 4> edge_inset{};  // edge k runs from corner k to k + 1
 };
