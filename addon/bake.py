@@ -26,8 +26,10 @@ MATERIAL_NAME = "Radiosity Emission"
 ATTRIBUTE = "Radiosity"
 MATERIAL_TAG = "radiosity_material"
 # Each side's polygons move this fraction of the scene's size towards the side
-# they show (0.1 mm in a 2 m room), so the two sides of a face never coincide.
-SIDE_OFFSET = 5e-5
+# they show (4 um in a 2 m room), so the two sides of a face never coincide;
+# less than any gap contact.h models (a lamp 0.1 mm above a table top must
+# stay in front of the table top under it).
+SIDE_OFFSET = 2e-6
 
 
 # --- The Radiosity collection ----------------------------------------------------------

@@ -10,6 +10,7 @@ What is exported, as a Cycles render would see it:
   viewport colour) and emitted radiance (Emission colour x strength of a
   Principled BSDF or an Emission shader);
 - area lights as one-sided emitting polygons (rectangle, square, disk, ellipse)
+  that cast no shadow (Cycles lets light through a light object: measured)
   with Blender's power-to-radiance conversion (geometry.area_light_radiance).
 What is not modelled (point, spot and sun lights, node setups other than the
 above) is collected in `ExportedScene.unmodelled` for one warning.
@@ -256,7 +257,7 @@ def export_scene(context, blender_version=None):
                 light_notes.add("light node setups")
             points = geometry.transform_points(local, matrix)
             n = len(points)
-            builder.add(points, np.arange(n), [n], [0.0, 0.0, 0.0], radiance, False)
+            builder.add(points, np.arange(n), [n], [0.0, 0.0, 0.0], radiance, False, occludes=False)
             part = Part(name=_unique(names_used, original.name), source=owner.name,
                         is_instance=inst.is_instance, is_light=True, face_count=1,
                         corner_points=points, face_sizes=np.array([n]))
@@ -302,6 +303,22 @@ def _unique(used, name):
     count = used.get(name, 0) + 1
     used[name] = count
     return name if count == 1 else "%s.%d" % (name, count)
+
+
+def coincident_message(exported, pairs, most=4):
+    """One warning line naming objects whose faces lie in the same place
+    (z-fighting in a render; the solver counts each such surface once), or ''."""
+    if not pairs:
+        return ""
+    face_part = exported.arrays["face_part"]
+    names = []
+    for a, b in pairs:
+        first, second = exported.parts[face_part[a]].name, exported.parts[face_part[b]].name
+        pair = first if first == second else "%s and %s" % tuple(sorted((first, second)))
+        if pair not in names:
+            names.append(pair)
+    more = " and %d more" % (len(names) - most) if len(names) > most else ""
+    return "faces in the same place, counted once: %s%s" % ("; ".join(names[:most]), more)
 
 
 def unmodelled_message(unmodelled):

@@ -115,12 +115,16 @@ class SceneBuilder:
     def __init__(self):
         self._positions, self._face_vertices, self._face_sizes = [], [], []
         self._reflectance, self._emission, self._two_sided, self._face_part = [], [], [], []
+        self._occludes = []
         self._vertex_count = 0
         self.part_count = 0
         self.part_face_start = []
 
-    def add(self, positions, face_vertices, face_sizes, reflectance, emission, two_sided):
-        """Add a part; per-face arrays have one row per face. Returns the part index."""
+    def add(self, positions, face_vertices, face_sizes, reflectance, emission, two_sided, occludes=True):
+        """Add a part; per-face arrays have one row per face. Returns the part index.
+
+        `occludes` False: the part emits but casts no shadow (a Blender light:
+        Cycles lets light through it)."""
         positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
         face_sizes = np.asarray(face_sizes, dtype=np.int64)
         faces = len(face_sizes)
@@ -132,6 +136,7 @@ class SceneBuilder:
         self._reflectance.append(np.broadcast_to(np.asarray(reflectance, dtype=np.float64), (faces, 3)))
         self._emission.append(np.broadcast_to(np.asarray(emission, dtype=np.float64), (faces, 3)))
         self._two_sided.append(np.broadcast_to(np.asarray(two_sided, dtype=bool), (faces,)))
+        self._occludes.append(np.broadcast_to(np.asarray(occludes, dtype=bool), (faces,)))
         self._face_part.append(np.full(faces, part, dtype=np.int64))
         self._vertex_count += len(positions)
         self.part_count += 1
@@ -153,6 +158,7 @@ class SceneBuilder:
             "reflectance": np.clip(cat(self._reflectance, (0, 3), np.float64), 0.0, 1.0),
             "emission": np.maximum(cat(self._emission, (0, 3), np.float64), 0.0),
             "two_sided": cat(self._two_sided, (0,), bool),
+            "occludes": cat(self._occludes, (0,), bool),
             "face_part": cat(self._face_part, (0,), np.int64),
         }
 

@@ -228,7 +228,8 @@ class RADIOSITY_OT_solve(Operator):
                              + (" (%s)" % note if note else ""))
         try:
             native_scene = solver.Scene(arrays["positions"], arrays["face_vertices"], arrays["face_sizes"],
-                                        arrays["reflectance"], arrays["emission"], arrays["two_sided"])
+                                        arrays["reflectance"], arrays["emission"], arrays["two_sided"],
+                                        occludes=arrays["occludes"])
         except ValueError as err:
             raise SolveError("Radiosity: %s" % err) from None
         settings = scene.radiosity
@@ -281,6 +282,9 @@ class RADIOSITY_OT_solve(Operator):
         hint = visibility_hint(job.options.get("visibility"), stats)
         if hint:
             warnings.append(hint)
+        coincident = export.coincident_message(job.exported, job.native_scene.coincident_faces)
+        if coincident:
+            warnings.append(coincident)
         skipped_faces = len(job.native_scene.skipped_faces)
         if skipped_faces:
             warnings.append("%d degenerate face%s skipped" % (skipped_faces, "s" if skipped_faces > 1 else ""))

@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cmath>
 #include <vector>
 
@@ -19,6 +20,11 @@ constexpr double kFootGap = 0.01;           // of the touching face's diameter
 constexpr double kCoincident = 1e-5;        // of the larger face's diameter
 constexpr double kCoincidentScene = 1e-6;   // of the scene's diameter
 constexpr double kThinnest = 1e-4;          // of the cut face's diameter
+// A face smaller than this share of the cut face's diameter (a chair leg on a
+// floor) is not cut around unless it emits: what could leak under it is
+// negligible, and its cuts, run across the pieces they cross, multiplied the
+// floor's pieces (full_office: 2.2 times the patches).
+constexpr double kSmallest = 0.02;
 
 double cross2(const dvec2& a, const dvec2& b) { return a.x * b.y - a.y * b.x; }
 
@@ -146,8 +152,16 @@ bool split(const Polygon2& piece, const Segment& s, double thinnest, Polygon2& l
 // lies in P's plane, Q's outline there (for merging coinciding pieces).
 struct Contact {
   std::vector<Segment> cuts;
-  std::vector<dvec2> coincident_outline;  // counter-clockwise; empty if Q does not lie in P's plane
+  std::vector<dvec2> cover_outline;  // counter-clockwise; empty if Q does not cover P
+  double gap = 0.0;                  // of a cover: the farthest of its corners from P's plane
+  bool coincident = false;           // a cover lying in P's plane
+  bool meets = false;                // cuts[0] is where Q meets P's plane
+  bool crosses = false;              // Q passes through P's plane there (not only rests on it)
 };
+
+bool emits(const Patch& q) {
+  return luminance(q.sides[0].emission) > 0.0 || luminance(q.sides[1].emission) > 0.0;
+}
 
 Contact contact_of(const Frame& f, double dp, const Patch& q, double dq, double scene_diameter) {
   Contact out;
@@ -163,17 +177,21 @@ Contact contact_of(const Frame& f, double dp, const Patch& q, double dq, double 
   const double touch = std::max(kCoincident * std::max(dp, dq), kCoincidentScene * scene_diameter);
   if (std::abs(glm::dot(f.n, q.normal)) >= kParallelCosine) {
     if (farthest > kCoverGap * std::min(dp, dq)) return out;
+    if (dq < kSmallest * dp && !emits(q)) return out;
     std::vector<dvec2> outline;
     for (int i = 0; i < q.corner_count; ++i) outline.push_back(f.to2(q.corners[static_cast<size_t>(i)]));
     if (signed_area(outline) < 0.0) std::reverse(outline.begin(), outline.end());
     for (size_t i = 0; i < outline.size(); ++i) out.cuts.push_back({outline[i], outline[(i + 1) % outline.size()]});
-    if (farthest <= touch) out.coincident_outline = std::move(outline);
+    out.coincident = farthest <= touch;
+    out.gap = farthest;
+    out.cover_outline = std::move(outline);
     return out;
   }
   // Where Q meets P's plane: the segment it crosses it along, or the edge
   // that rests on it.
   std::vector<dvec3> points;
-  if (lo < -touch && hi > touch) {
+  out.crosses = lo < -touch && hi > touch;
+  if (out.crosses) {
     for (int i = 0; i < q.corner_count; ++i) {
       const int j = (i + 1) % q.corner_count;
       const dvec3& a = q.corners[static_cast<size_t>(i)];
@@ -196,7 +214,9 @@ Contact contact_of(const Frame& f, double dp, const Patch& q, double dq, double 
       const double d = glm::length(points[i] - points[j]);
       if (d > best) best = d, a = i, b = j;
     }
+  if (best < kSmallest * dp && !emits(q)) return out;
   out.cuts.push_back({f.to2(points[a]), f.to2(points[b])});
+  out.meets = true;
   return out;
 }
 
@@ -208,34 +228,134 @@ struct Piece {
   std::int64_t merged_into = -1;              // index in the flat piece list
   dvec3 centre{0.0};
   double area = 0.0;
+  std::vector<std::uint32_t> corner_class;  // per polygon corner (Patch::corner_class)
+  std::vector<float> edge_inset;            // per polygon edge (Patch::edge_inset)
 };
+
+// What in P's plane makes the radiance discontinuous: the outlines of covers
+// (with their gap, 0 where they touch) and the segments where faces meet it.
+struct Features {
+  struct Cover {
+    std::vector<dvec2> outline;
+    double gap;
+  };
+  struct Meeting {
+    Segment segment;
+    bool crosses;  // the other face passes through this one there
+  };
+  std::vector<Cover> covers;
+  std::vector<Meeting> meetings;
+};
+
+double distance_to_segment(const dvec2& p, const Segment& s) {
+  const dvec2 d = s.b - s.a;
+  const double t = std::clamp(glm::dot(p - s.a, d) / glm::dot(d, d), 0.0, 1.0);
+  return glm::length(p - (s.a + t * d));
+}
+
+// Classes of the piece's corners and insets of its edges (Patch); `thinnest`
+// is kThinnest of the patch's diameter.
+void mark_discontinuities(Piece& piece, const Polygon2& polygon, const Polygon2& whole, const Features& features,
+                          const dvec2& centroid, double thinnest) {
+  const double near = 1e-3 * thinnest;
+  const size_t n = polygon.size();
+  piece.corner_class.assign(n, 0u);
+  piece.edge_inset.assign(n, 0.0f);
+  for (size_t i = 0; i < n; ++i) {
+    const dvec2 v = polygon[i].p;
+    // A point of the piece next to the corner says which side of each line
+    // through it the piece lies on.
+    const dvec2 inner = v + 1e-3 * (centroid - v);
+    std::uint64_t signature = 0;
+    bool on_line = false;
+    for (size_t k = 0; k < features.covers.size(); ++k) {
+      const auto& outline = features.covers[k].outline;
+      bool on = false;
+      for (size_t e = 0; e < outline.size() && !on; ++e)
+        on = distance_to_segment(v, {outline[e], outline[(e + 1) % outline.size()]}) <= near;
+      if (!on) continue;
+      on_line = true;
+      signature = signature * 1000003u + 2 * k + (inside(outline, inner, 0.0) ? 1 : 0);
+    }
+    for (size_t k = 0; k < features.meetings.size(); ++k) {
+      const Segment& s = features.meetings[k].segment;
+      if (distance_to_segment(v, s) > near) continue;
+      on_line = true;
+      const dvec2 d = s.b - s.a;
+      const double t = glm::dot(inner - s.a, d) / glm::dot(d, d);
+      const int side = t < 0.0 || t > 1.0 ? 2 : (cross2(d, inner - s.a) > 0.0 ? 1 : 0);
+      signature = signature * 1000003u + 3 * (k + features.covers.size()) + static_cast<std::uint64_t>(side);
+    }
+    if (on_line) piece.corner_class[i] = static_cast<std::uint32_t>(signature | 1u << 31);
+    // Edges along the outline of a cover some gap away, and along a line
+    // where another face passes through this one (a sample a millionth from
+    // that face sees it edge-on: projecting it to find what it hides is then
+    // ill-conditioned, and a plate through a wall let 1e-9 of the light behind
+    // the wall through). Not along the face's own edges.
+    const dvec2 w = polygon[(i + 1) % n].p;
+    bool own_edge = false;
+    for (size_t e = 0; e < whole.size() && !own_edge; ++e) {
+      const Segment edge{whole[e].p, whole[(e + 1) % whole.size()].p};
+      own_edge = distance_to_segment(v, edge) <= near && distance_to_segment(w, edge) <= near;
+    }
+    for (const Features::Meeting& m : features.meetings) {
+      if (m.crosses && !own_edge && distance_to_segment(v, m.segment) <= near && distance_to_segment(w, m.segment) <= near)
+        piece.edge_inset[i] = std::max(piece.edge_inset[i], static_cast<float>(10.0 * thinnest));
+    }
+    for (const Features::Cover& cover : features.covers) {
+      if (!(cover.gap > 0.0)) continue;
+      for (size_t e = 0; e < cover.outline.size(); ++e) {
+        const Segment edge{cover.outline[e], cover.outline[(e + 1) % cover.outline.size()]};
+        if (distance_to_segment(v, edge) <= near && distance_to_segment(w, edge) <= near)
+          piece.edge_inset[i] = std::max(piece.edge_inset[i], static_cast<float>(4.0 * cover.gap));
+      }
+    }
+  }
+}
 
 // The convex polygon as triangles and quads, dropping corners that lie on
 // the line of their neighbours (a cut that ended on an edge).
 void append_patches(const Patch& source, const Piece& piece, std::vector<Patch>& out) {
   std::vector<dvec3> corners;
+  std::vector<std::uint32_t> classes;
+  std::vector<float> insets;  // of the edge leaving each kept corner
   const Polygon2& poly = piece.polygon;
   const double scale = std::sqrt(piece.area);
   for (size_t i = 0; i < poly.size(); ++i) {
     const dvec2& prev = poly[(i + poly.size() - 1) % poly.size()].p;
     const dvec2& here = poly[i].p;
     const dvec2& next = poly[(i + 1) % poly.size()].p;
-    if (glm::length(here - prev) <= 1e-9 * scale) continue;
-    if (cross2(here - prev, next - here) <= 1e-9 * glm::length(here - prev) * glm::length(next - here)) continue;
+    const bool dropped = glm::length(here - prev) <= 1e-9 * scale ||
+                         cross2(here - prev, next - here) <= 1e-9 * glm::length(here - prev) * glm::length(next - here);
+    if (dropped) {
+      // The edge before it now runs on: it keeps an inset only if both had it.
+      if (!insets.empty()) insets.back() = std::min(insets.back(), piece.edge_inset[i]);
+      continue;
+    }
     corners.push_back(poly[i].x);
+    classes.push_back(piece.corner_class[i]);
+    insets.push_back(piece.edge_inset[i]);
   }
+  const size_t n = corners.size();
   const auto emit = [&](std::initializer_list<size_t> index) {
     Patch p = source;
     p.corner_count = static_cast<std::uint8_t>(index.size());
     size_t k = 0;
-    for (size_t i : index) p.corners[k++] = corners[i];
+    for (size_t i : index) {
+      p.corner_class[k] = classes[i];
+      p.corners[k++] = corners[i];
+    }
+    const auto* first = index.begin();
+    for (size_t e = 0; e < k; ++e) {
+      const size_t a = first[e], b = first[(e + 1) % k];
+      p.edge_inset[e] = (a + 1) % n == b ? insets[a] : 0.0f;  // along the piece's outline, not a diagonal
+    }
     dvec3 area_normal(0.0);
     for (size_t i = 1; i + 1 < k; ++i) area_normal += glm::cross(p.corners[i] - p.corners[0], p.corners[i + 1] - p.corners[0]);
     p.area = 0.5 * glm::length(area_normal);
     p.sides = piece.sides;
     if (p.area > 0.0) out.push_back(p);
   };
-  const size_t n = corners.size();
   if (n < 3) return;
   size_t i = 1;
   for (; i + 2 < n; i += 2) emit({0, i, i + 1, i + 2});
@@ -279,7 +399,8 @@ void mesh_contacts(Scene& scene) {
       box.lo -= margin;
       box.hi += margin;
       near.clear();
-      traverse_scene_bvh(
+      // A face that casts no shadow (a Blender light) neither cuts nor is cut.
+      if (patch.occludes) traverse_scene_bvh(
           bvh,
           [&](const Aabb& b) {
             return b.lo.x <= box.hi.x && b.hi.x >= box.lo.x && b.lo.y <= box.hi.y && b.hi.y >= box.lo.y &&
@@ -287,17 +408,23 @@ void mesh_contacts(Scene& scene) {
           },
           [&](std::uint32_t t) {
             const std::uint32_t q = owner[t];
-            if (q != p && patches[q].surface != patch.surface) near.push_back(q);
+            if (q != p && patches[q].surface != patch.surface && patches[q].occludes) near.push_back(q);
           });
       std::sort(near.begin(), near.end());
       near.erase(std::unique(near.begin(), near.end()), near.end());
 
       std::vector<Segment> cuts;
       std::vector<std::pair<std::uint32_t, std::vector<dvec2>>> coincident;
+      Features features;
+      const double touch_p = kCoincidentScene * scene.diameter;
       for (std::uint32_t q : near) {
         Contact c = contact_of(f, diameter[p], patches[q], diameter[q], scene.diameter);
         cuts.insert(cuts.end(), c.cuts.begin(), c.cuts.end());
-        if (!c.coincident_outline.empty()) coincident.emplace_back(q, std::move(c.coincident_outline));
+        if (c.meets) features.meetings.push_back({c.cuts[0], c.crosses});
+        if (!c.cover_outline.empty()) {
+          features.covers.push_back({c.cover_outline, c.gap > std::max(touch_p, kCoincident * diameter[p]) ? c.gap : 0.0});
+          if (c.coincident) coincident.emplace_back(q, std::move(c.cover_outline));
+        }
       }
       Polygon2 whole;
       for (int k = 0; k < patch.corner_count; ++k)
@@ -326,6 +453,7 @@ void mesh_contacts(Scene& scene) {
         piece.centre = f.origin + c.x * f.u + c.y * f.v;
         for (const auto& [q, outline] : coincident)
           if (inside(outline, c, thinnest)) piece.coincides_with.push_back(q);
+        mark_discontinuities(piece, polygon, whole, features, c, thinnest);
         piece.polygon = std::move(polygon);
         piece.sides = patch.sides;
         cut[p].push_back(std::move(piece));
@@ -366,8 +494,8 @@ void mesh_contacts(Scene& scene) {
       if (target < 0) continue;
       target = resolve(target);
       Piece& into = *flat[static_cast<size_t>(target)];
-      size_t owner_patch = 0;
-      while (first_piece[owner_patch + 1] <= static_cast<size_t>(target)) ++owner_patch;
+      const size_t owner_patch = static_cast<size_t>(
+          std::upper_bound(first_piece.begin(), first_piece.end(), static_cast<size_t>(target)) - first_piece.begin() - 1);
       const bool same_facing = glm::dot(patches[p].normal, patches[owner_patch].normal) > 0.0;
       for (size_t s = 0; s < 2; ++s) {
         const PatchSide& side = piece.sides[s];
@@ -395,7 +523,12 @@ void mesh_contacts(Scene& scene) {
   for (size_t p = 0; p < n; ++p) {
     if (cut[p].size() == 1 && cut[p][0].merged_into < 0) {
       Patch whole = patches[p];
-      whole.sides = cut[p][0].sides;
+      const Piece& piece = cut[p][0];
+      whole.sides = piece.sides;
+      for (int k = 0; k < whole.corner_count; ++k) {
+        whole.corner_class[static_cast<size_t>(k)] = piece.corner_class[static_cast<size_t>(k)];
+        whole.edge_inset[static_cast<size_t>(k)] = piece.edge_inset[static_cast<size_t>(k)];
+      }
       out.push_back(whole);
       continue;
     }

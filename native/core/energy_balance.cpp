@@ -18,6 +18,12 @@ constexpr double kDownScaleMin = 0.9, kDownScaleMax = 1.1;
 // Below this share of its hemisphere from its ancestors, a sample's closure
 // says too little about their links to correct them.
 constexpr double kMinDownCoverage = 0.05;
+// Only where a surface sees nothing but linked surfaces is its closure known
+// to be smooth (1 in a closed room, to the links' energy corrections); near an
+// opening or a black surface it varies as fast as the far links it would
+// correct (correcting to its interpolation made an open Cornell box 4 % too
+// bright).
+constexpr double kClosed = 1.0 - 1e-3;
 
 bool reflects(const Hierarchy& h, const Element& e) { return luminance(h.reflectance(e)) > 0.0; }
 
@@ -140,24 +146,42 @@ void EnergyBalance::update(const Hierarchy& h, const LinkGather& grouping, const
       for (size_t s = 0; s < kMaxSamples; ++s) closure_[e + c][s] = static_cast<float>(children[c][s].x);
   }
 
+  // Per leaf sample of a closed top-level element, the factor on what the
+  // ancestors push down. Whether it is closed is decided for the whole
+  // top-level element (its own samples' closure), not sample by sample:
+  // correcting only the samples whose closure comes out at 1 or more would
+  // pick those the links' energy corrections pushed up, and make light (0.2 %
+  // in a closed room with a light a hair under its ceiling).
   down_scale_.assign(n, SampleScale{1, 1, 1, 1, 1});
+  std::vector<std::uint8_t> closed_root(h.root_count(), 0);
+  for (size_t r = 0; r < h.root_count(); ++r) {
+    const std::int32_t root = h.root(static_cast<std::uint32_t>(r / 2), static_cast<int>(r % 2));
+    if (root == kNone) continue;
+    const Element& x = h.element(root);
+    bool closed = true;
+    for (int s = 0; s < x.sample_count(); ++s) closed &= closure_[static_cast<size_t>(root)][static_cast<size_t>(s)] >= kClosed;
+    closed_root[r] = closed ? 1 : 0;
+  }
   std::vector<double> receiving(n, 0.0);  // per leaf: closure over the surfaces that reflect
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const auto& range) {
     for (size_t e = range.begin(); e != range.end(); ++e) {
       const Element& x = elements[e];
       if (!x.is_leaf() || !x.has_links) continue;
+      const bool closed = closed_root[2 * static_cast<size_t>(x.patch) + x.side] != 0;
       const SampleRgb own = coverage(static_cast<std::int32_t>(e));
       SampleRgb received{};
       for (int s = 0; s < x.sample_count(); ++s) {
         const size_t k = static_cast<size_t>(s);
         const Rgb down = at_leaves[e][k] - own[k];
         double scale = 1.0;
-        if (down.x > kMinDownCoverage)
+        if (closed && down.x > kMinDownCoverage)
           scale = std::clamp((static_cast<double>(closure_[e][k]) - own[k].x) / down.x, kDownScaleMin, kDownScaleMax);
         down_scale_[e][k] = static_cast<float>(scale);
         received[k] = own[k] + scale * down;
       }
-      receiving[e] = Interpolant::average(x.corner_count, received).y;
+      // At most the whole hemisphere: where the samples say more, it is the
+      // energy correction of a link (link_transport) showing at a point.
+      receiving[e] = std::min(1.0, Interpolant::average(x.corner_count, received).y);
     }
   });
 

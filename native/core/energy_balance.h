@@ -9,12 +9,15 @@
 // from the far links is the parent's interpolant, whose error is the error of
 // interpolating those links' form factors (the furnace, every surface
 // emitting and reflecting alike, came out 0.4 % off at rho = 0.5 and 1.4 % at
-// 0.9). The closure is far smoother than the far links' form factors alone
-// (constant in a closed room), so each element's closure is known at its
-// samples: from its links for the top-level elements, interpolated from the
-// parent for the others. At a leaf sample, what its ancestors pushed down is
-// scaled so that the form factors there sum to the closure:
-//   H = H_own + H_down (C - F_own) / F_down.
+// 0.9). Where a point sees nothing but linked surfaces (inside a closed room)
+// its closure is exactly 1, whatever the far links' interpolation says. Each
+// element's closure is known at its samples (from its links for the
+// top-level elements, pushed down from the parent for the others); at a leaf
+// sample whose closure is 1 (to 1e-3), what its ancestors pushed down is
+// scaled so that the form factors there sum to 1:
+//   H = H_own + H_down (1 - F_own) / F_down.
+// Elsewhere (near an opening, a black surface) the closure varies as fast as
+// what it would correct, and nothing is scaled.
 //
 // Sending. A link p <- X carries the exact exchange between p and X (the
 // energy correction of link_transport), but it takes X's light as one

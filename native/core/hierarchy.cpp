@@ -108,15 +108,16 @@ namespace {
 struct CornerKey {
   std::uint32_t face;
   std::uint8_t face_side;
+  std::uint32_t corner_class;  // Patch::corner_class: which side of a discontinuity
   dvec3 position;
   bool operator==(const CornerKey& o) const {
-    return face == o.face && face_side == o.face_side && position == o.position;
+    return face == o.face && face_side == o.face_side && corner_class == o.corner_class && position == o.position;
   }
 };
 
 struct CornerHash {
   size_t operator()(const CornerKey& k) const {
-    size_t h = std::hash<std::uint64_t>()((static_cast<std::uint64_t>(k.face) << 1) | k.face_side);
+    size_t h = std::hash<std::uint64_t>()((static_cast<std::uint64_t>(k.face) << 33) ^ (static_cast<std::uint64_t>(k.corner_class) << 1) ^ k.face_side);
     for (int i = 0; i < 3; ++i) h = h * 1000003u ^ std::hash<double>()(k.position[i]);
     return h;
   }
@@ -142,7 +143,7 @@ Hierarchy::Hierarchy(const Scene& scene) : scene_(&scene) {
       for (int k = 0; k < patch.corner_count; ++k) {
         const int source = side == 0 ? k : (patch.corner_count - k) % patch.corner_count;
         const dvec3 corner = patch.corners[static_cast<size_t>(source)] + dvec3(0.0);  // no -0.0 in the key
-        const auto [it, made] = shared.try_emplace(CornerKey{shown.face, shown.face_side, corner}, 0u);
+        const auto [it, made] = shared.try_emplace(CornerKey{shown.face, shown.face_side, patch.corner_class[static_cast<size_t>(source)], corner}, 0u);
         if (made) it->second = add_vertex(corner);
         e.corner[static_cast<size_t>(k)] = it->second;
       }
@@ -175,11 +176,36 @@ double Hierarchy::diameter(const Element& e) const {
   return d;
 }
 
+namespace {
+
+// How far a sample at `v` keeps from the patch's inset edges (Patch::edge_inset).
+double inset_at(const Patch& p, const dvec3& v) {
+  double inset = 0.0;
+  for (int j = 0; j < p.corner_count; ++j) {
+    const double wanted = static_cast<double>(p.edge_inset[static_cast<size_t>(j)]);
+    if (!(wanted > inset)) continue;
+    const dvec3& a = p.corners[static_cast<size_t>(j)];
+    const dvec3 ab = p.corners[static_cast<size_t>((j + 1) % p.corner_count)] - a;
+    const double t = std::clamp(glm::dot(v - a, ab) / glm::dot(ab, ab), 0.0, 1.0);
+    if (glm::length(v - (a + t * ab)) <= 1e-9 * glm::length(ab)) inset = wanted;
+  }
+  return inset;
+}
+
+}  // namespace
+
 int Hierarchy::samples(const Element& e, dvec3* out) const {
   const dvec3 c = centre(e);
+  const Patch& patch = patch_of(e);
+  const bool insets = has_insets(e);
   for (int k = 0; k < e.corner_count; ++k) {
     const dvec3& v = vertices_[e.corner[static_cast<size_t>(k)]];
-    out[k] = v + 1e-6 * (c - v);
+    double move = 1e-6;
+    if (insets) {
+      const double to_centre = glm::length(c - v);
+      move = std::max(move, std::min(0.25, inset_at(patch, v) / to_centre));
+    }
+    out[k] = v + move * (c - v);
   }
   out[e.corner_count] = c;
   return e.corner_count + 1;

@@ -68,6 +68,12 @@ class Hierarchy {
   // element's size, so a corner on an edge shared with an emitter keeps a finite
   // gradient (MATH.md s3), then the centre. Returns the count.
   int samples(const Element& e, dvec3* out) const;
+  // Whether some corner sample of the element may sit further in, off a
+  // contact line (Patch::edge_inset).
+  bool has_insets(const Element& e) const {
+    const auto& inset = patch_of(e).edge_inset;
+    return inset[0] > 0.0f || inset[1] > 0.0f || inset[2] > 0.0f || inset[3] > 0.0f;
+  }
 
   // Splits a leaf into four children (no-op if already split); returns the
   // first child. Children inherit the parent's radiance.

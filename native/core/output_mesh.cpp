@@ -206,11 +206,27 @@ OutputMesh make_output_mesh(const Hierarchy& h,
   std::vector<std::int32_t> root_of(elements.size());
   for (size_t i = 0; i < elements.size(); ++i)  // parents come before children
     root_of[i] = elements[i].parent == kNone ? static_cast<std::int32_t>(i) : root_of[static_cast<size_t>(elements[i].parent)];
-  std::vector<std::uint32_t> polygon, edge;
+  // A foreign vertex is placed where the other patch has it, with this
+  // polygon's own radiance there (interpolated along its edge): the other
+  // patch may lie across a discontinuity (contact.h), whose light must not
+  // bleed over.
+  const auto interpolated_vertex = [&](std::uint32_t v, std::uint32_t a, std::uint32_t b) {
+    const dvec3 p = h.vertex(v), pa = h.vertex(a), ab = h.vertex(b) - pa;
+    const double t = std::clamp(glm::dot(p - pa, ab) / glm::dot(ab, ab), 0.0, 1.0);
+    const auto value = [&](std::uint32_t u) {
+      return count[u] ? sum[u] / static_cast<double>(count[u]) : glm::dvec3(0.0);
+    };
+    const glm::dvec3 l = (1 - t) * value(a) + t * value(b);
+    const auto index = static_cast<std::int32_t>(mesh.positions.size() / 3);
+    mesh.positions.insert(mesh.positions.end(), {p.x, p.y, p.z});
+    mesh.radiance.insert(mesh.radiance.end(), {static_cast<float>(l.x), static_cast<float>(l.y), static_cast<float>(l.z)});
+    return index;
+  };
+  std::vector<std::uint32_t> edge, between;
   for (size_t i = 0; i < elements.size(); ++i) {
     const Element& e = elements[i];
     if (!e.is_leaf() || !shown(e.patch, e.side)) continue;
-    polygon.clear();
+    const size_t polygon_start = mesh.face_vertices.size();
     for (int k = 0; k < e.corner_count; ++k) {
       const std::uint32_t a = e.corner[static_cast<size_t>(k)];
       const std::uint32_t b = e.corner[static_cast<size_t>((k + 1) % e.corner_count)];
@@ -218,12 +234,13 @@ OutputMesh make_output_mesh(const Hierarchy& h,
       boundary_chain(h, a, b, edge);
       edge.push_back(b);
       for (size_t j = 0; j + 1 < edge.size(); ++j) {
-        polygon.push_back(edge[j]);
-        foreign.append_between(root_of[i], edge[j], edge[j + 1], polygon);
+        mesh.face_vertices.push_back(output_vertex(edge[j]));
+        between.clear();
+        foreign.append_between(root_of[i], edge[j], edge[j + 1], between);
+        for (std::uint32_t v : between) mesh.face_vertices.push_back(interpolated_vertex(v, edge[j], edge[j + 1]));
       }
     }
-    for (std::uint32_t v : polygon) mesh.face_vertices.push_back(output_vertex(v));
-    mesh.face_sizes.push_back(static_cast<std::int32_t>(polygon.size()));
+    mesh.face_sizes.push_back(static_cast<std::int32_t>(mesh.face_vertices.size() - polygon_start));
     mesh.source_face.push_back(static_cast<std::int32_t>(h.side_of(e).face));
     mesh.source_side.push_back(h.side_of(e).face_side);
     const Rgb mean = glm::max(Interpolant::average(e.corner_count, leaf_irradiance[i]), Rgb(0.0));

@@ -38,6 +38,7 @@ struct PatchBuilder {
   Scene& scene;
   const Rgb reflectance, emission;
   const bool two_sided;
+  const bool occludes;
   const std::uint32_t face;
   int made = 0;
 
@@ -51,6 +52,7 @@ struct PatchBuilder {
     p.corner_count = static_cast<std::uint8_t>(corners.size());
     std::copy(corners.begin(), corners.end(), p.corners.begin());
     p.surface = face;
+    p.occludes = occludes;
     p.normal = area_normal / area;
     p.area = area;
     for (std::uint8_t side = 0; side < 2; ++side) {
@@ -142,6 +144,9 @@ void check_sizes(const SceneArrays& a) {
   if (!a.two_sided.empty() && a.two_sided.size() != faces) {
     fail("two_sided must have one entry per face (" + std::to_string(faces) + ")");
   }
+  if (!a.occludes.empty() && a.occludes.size() != faces) {
+    fail("occludes must have one entry per face (" + std::to_string(faces) + ")");
+  }
   std::int64_t total = 0;
   for (size_t f = 0; f < faces; ++f) {
     if (a.face_sizes[f] < 3) {
@@ -217,7 +222,8 @@ Scene make_scene(const SceneArrays& a) {
     PatchBuilder builder{scene,
                          Rgb(a.reflectance[3 * f], a.reflectance[3 * f + 1], a.reflectance[3 * f + 2]),
                          Rgb(a.emission[3 * f], a.emission[3 * f + 1], a.emission[3 * f + 2]),
-                         a.two_sided.empty() || a.two_sided[f] != 0, static_cast<std::uint32_t>(f)};
+                         a.two_sided.empty() || a.two_sided[f] != 0, a.occludes.empty() || a.occludes[f] != 0,
+                         static_cast<std::uint32_t>(f)};
     const double diameter = polygon_diameter(polygon);
     if (!(glm::length(polygon_area_normal(polygon)) > kDegenerate * diameter * diameter)) {
       scene.skipped.push_back({static_cast<std::uint32_t>(f),

@@ -23,6 +23,9 @@ struct SceneArrays {
   std::span<const double> reflectance;     // 3 per face, in [0, 1]
   std::span<const double> emission;        // 3 per face, radiance >= 0
   std::span<const std::uint8_t> two_sided;  // per face, or empty: every face two-sided
+  // Per face, or empty: every face casts shadows. Blender's lights do not
+  // (Cycles lets light through them, measured): their polygons only emit.
+  std::span<const std::uint8_t> occludes;
 };
 
 // One side of a patch: the input face it shows and that face's material.
@@ -47,7 +50,18 @@ struct Patch {
   // of a split face, the triangles of an n-gon), or for faces merged where
   // they coincide, the first of them.
   std::uint32_t surface = 0;
+  bool occludes = true;  // casts shadows and takes part in contact meshing
   std::array<PatchSide, 2> sides{};  // front, back
+  // Where contact.h cut the patch along the outline of something lying on it
+  // or a line where something meets it, the radiance is discontinuous:
+  // corners there are shared only with the patches of the same face on the
+  // same side of it (class 0: no such line through the corner); samples on
+  // an edge along the outline of a cover a gap g away move 4 g into the patch
+  // (the cover's penumbra there is only about g wide), on a cut where a face
+  // passes through it 1e-3 of its diameter (so they do not see that face
+  // edge-on).
+  std::array<std::uint32_t, 4> corner_class{};
+  std::array<float, 4> edge_inset{};  // edge k runs from corner k to k + 1
 };
 
 struct SkippedFace {

@@ -47,7 +47,7 @@ InputArray<std::int64_t> read_indices(const py::handle& object, const std::strin
 
 Scene make_python_scene(const py::handle& positions, const py::handle& face_vertices,
                         const py::handle& face_sizes, const py::handle& reflectance,
-                        const py::handle& emission, const py::handle& two_sided) {
+                        const py::handle& emission, const py::handle& two_sided, const py::handle& occludes) {
   const auto p = read_array_of<double>(positions, "positions", {-1, 3});
   const auto fv = read_indices(face_vertices, "face_vertices");
   const auto fs = read_indices(face_sizes, "face_sizes");
@@ -56,6 +56,8 @@ Scene make_python_scene(const py::handle& positions, const py::handle& face_vert
   const auto le = read_array_of<double>(emission, "emission", {faces, 3});
   InputArray<std::uint8_t> sided;
   if (!two_sided.is_none()) sided = read_array_of<std::uint8_t>(two_sided, "two_sided", {faces});
+  InputArray<std::uint8_t> shadows;
+  if (!occludes.is_none()) shadows = read_array_of<std::uint8_t>(occludes, "occludes", {faces});
   SceneArrays arrays;
   arrays.positions = {p.data(), static_cast<size_t>(p.size())};
   arrays.face_vertices = {fv.data(), static_cast<size_t>(fv.size())};
@@ -63,6 +65,7 @@ Scene make_python_scene(const py::handle& positions, const py::handle& face_vert
   arrays.reflectance = {rho.data(), static_cast<size_t>(rho.size())};
   arrays.emission = {le.data(), static_cast<size_t>(le.size())};
   if (sided) arrays.two_sided = {sided.data(), static_cast<size_t>(sided.size())};
+  if (shadows) arrays.occludes = {shadows.data(), static_cast<size_t>(shadows.size())};
   return make_scene(arrays);
 }
 
@@ -237,15 +240,16 @@ void bind_solver(py::module_& m) {
       .def_property_readonly("cancelled", [](const CancelToken& t) { return t.flag.load(); });
 
   py::class_<Scene>(m, "Scene",
-                    "Scene(positions, face_vertices, face_sizes, reflectance, emission, two_sided=None)\n\n"
+                    "Scene(positions, face_vertices, face_sizes, reflectance, emission, two_sided=None, occludes=None)\n\n"
                     "positions (V, 3) float; face_vertices: all faces' vertex indices concatenated;\n"
                     "face_sizes (F,) vertices per face (3 or more; larger polygons are triangulated);\n"
                     "reflectance (F, 3) in [0, 1]; emission (F, 3) radiance >= 0; two_sided (F,) bool,\n"
-                    "default all True (a one-sided face has only its front: area lights).\n"
+                    "default all True (a one-sided face has only its front: area lights); occludes (F,) bool,\n"
+                    "default all True (False: the face emits but casts no shadow, as Blender's lights).\n"
                     "Degenerate faces are skipped and listed in skipped_faces; bad input raises ValueError.")
       .def(py::init(&make_python_scene), py::arg("positions"), py::arg("face_vertices"),
            py::arg("face_sizes"), py::arg("reflectance"), py::arg("emission"),
-           py::arg("two_sided") = py::none())
+           py::arg("two_sided") = py::none(), py::arg("occludes") = py::none())
       .def_property_readonly("face_count", [](const Scene& s) { return s.face_count; })
       .def_property_readonly("patch_count", [](const Scene& s) { return s.patches.size(); })
       .def_property_readonly("total_area", [](const Scene& s) { return s.total_area; })

@@ -34,7 +34,7 @@ struct Arrays {
     emission.insert(emission.end(), {emit, emit, emit});
     two_sided.push_back(both_sides ? 1 : 0);
   }
-  Scene scene() const { return make_scene({positions, faces, sizes, reflectance, emission, two_sided}); }
+  Scene scene() const { return make_scene({positions, faces, sizes, reflectance, emission, two_sided, {}}); }
 };
 
 // A grid of n x n small squares at height z, facing up or down.
@@ -114,19 +114,27 @@ TEST(ClusterLinks, FarGridsShareLinksNearOnesDoNot) {
 }
 
 TEST(ClusterLinks, FarLightMatchesThePointFormFactorsOfItsSides) {
-  // A 4 x 4 grid of lights 20 above a 4 x 4 grid of receivers: what each
-  // receiver gathers through cluster links against the sum of the exact
-  // point-to-polygon form factors of the lights at its centre.
+  // A 4 x 4 grid of lit squares (radiance 2) 20 above a 4 x 4 grid of
+  // receivers: what each receiver gathers through cluster links against the
+  // sum of the exact point-to-polygon form factors of the squares at its
+  // centre. (Emitters themselves always go through face links.)
   Arrays a;
   grid(a, 0.0, 4, true, 0.5, 0.0);
-  grid(a, 20.0, 4, false, 0.0, 2.0);
+  grid(a, 20.0, 4, false, 0.5, 0.0);
+  a.square(dvec3(0.0, 0.0, -50.0), 0.1, false, 0.0, 1.0);  // a scene needs an emitter: this one faces away
   const Linked linked(a);
   const Hierarchy& h = linked.h;
   const ClusterTree& tree = linked.tree;
   const InitialLinks links = linked.link(2.0);
-  ASSERT_EQ(links.elements.size(), 0u);
+  ASSERT_GT(links.clusters.size(), 0u);
+  // Pairs the walk left to face links are not part of the cluster light.
+  const auto face_linked = [&](std::int32_t receiver, std::int32_t emitter) {
+    for (const Link& l : links.elements)
+      if (l.receiver == receiver && l.emitter == emitter) return true;
+    return false;
+  };
   std::vector<Rgb> radiance(h.elements().size(), Rgb(0.0));
-  for (size_t e = 0; e < h.elements().size(); ++e) radiance[e] = h.emission(h.element(static_cast<std::int32_t>(e)));
+  for (std::uint32_t q = 16; q < 32; ++q) radiance[static_cast<size_t>(h.root(q, 0))] = Rgb(2.0);
   std::vector<Rgb> gathered(h.elements().size(), Rgb(0.0));
   ClusterGather gather;
   gather(tree, links.clusters, h, radiance, gathered);
@@ -134,6 +142,7 @@ TEST(ClusterLinks, FarLightMatchesThePointFormFactorsOfItsSides) {
     const Element& receiver = h.element(h.root(static_cast<std::uint32_t>(r), 0));
     double exact = 0.0;
     for (std::uint32_t q = 16; q < 32; ++q) {
+      if (face_linked(h.root(static_cast<std::uint32_t>(r), 0), h.root(q, 0))) continue;
       dvec3 c[4];
       const int n = h.corners(h.element(h.root(q, 0)), c);
       exact += 2.0 * form_factor(h.centre(receiver), h.normal(receiver), std::span<const dvec3>(c, static_cast<size_t>(n)));
@@ -142,16 +151,30 @@ TEST(ClusterLinks, FarLightMatchesThePointFormFactorsOfItsSides) {
   }
 }
 
-TEST(ClusterLinks, SidesHiddenFromTheLightsGetNoLinksFromThem) {
-  // A two-sided square far above a grid of lights, and a one-sided one hidden
-  // right above it: the square's top faces away from the lights, the hidden
-  // one is behind it. Neither may receive from the grid through a cluster
-  // link (pairs of sides are left to the exact link evaluation).
+TEST(ClusterLinks, LightStraightFromEmittersGoesThroughFaceLinks) {
+  // The same grids with the upper one emitting: far apart as they are, every
+  // pair is a face link (exact visibility at the receivers' samples).
   Arrays a;
-  grid(a, 0.0, 4, true, 0.5, 1.0);
+  grid(a, 0.0, 4, true, 0.5, 0.0);
+  grid(a, 20.0, 4, false, 0.0, 2.0);
+  const Linked linked(a);
+  const InitialLinks links = linked.link(2.0);
+  EXPECT_EQ(links.clusters.size(), 0u);
+  EXPECT_EQ(links.elements.size(), 16u * 16u);
+}
+
+TEST(ClusterLinks, SidesHiddenFromTheLightsGetNoLinksFromThem) {
+  // A two-sided square far above a grid of reflecting squares, and a
+  // one-sided one hidden right above it: the square's top faces away from the
+  // grid, the hidden one is behind it. Neither may receive from the grid
+  // through a cluster link (pairs of sides are left to the exact link
+  // evaluation).
+  Arrays a;
+  grid(a, 0.0, 4, true, 0.5, 0.0);
   const dvec3 lo(0.0, 0.0, 10.0);
   a.square(lo, 1.0, false, 0.5, 0.0, true);                 // bottom, two-sided
   a.square(lo + dvec3(0.25, 0.25, 0.5), 0.5, false, 0.5, 0.0);  // hidden, facing down
+  a.square(dvec3(0.0, 0.0, -50.0), 0.1, false, 0.0, 1.0);       // a scene needs an emitter: this one faces away
   const Linked linked(a);
   const Hierarchy& h = linked.h;
   const ClusterTree& tree = linked.tree;

@@ -64,5 +64,7 @@ def check():
 
 bpy.app.timers.register(start, first_interval=1.0)
 if MODE == "cancel":
-    bpy.app.timers.register(escape, first_interval=2.0)
+    # Late enough that the first pass (linking and the unrefined solve) is done
+    # on a loaded machine, early enough that the solve at quality 1 is not.
+    bpy.app.timers.register(escape, first_interval=8.0)
 bpy.app.timers.register(check, first_interval=1.5)

@@ -227,6 +227,28 @@ class SolveCubeTest(unittest.TestCase):
         self.assertFalse(any(o.show_wire for o in bake.result_objects(scene)))
 
 
+class DoubledWallTest(unittest.TestCase):
+    def test_a_doubled_wall_solves_like_one_and_is_named(self):
+        # An imported model often carries a face twice (z-fighting in a
+        # render): the solver counts the surface once, and the warning says so.
+        def solve(doubled):
+            scene = open_scene("cube")
+            wall = next(o for o in scene.objects if o.type == 'MESH' and "Wall" in o.name)
+            if doubled:
+                copy = wall.copy()   # shares the mesh: every face of the copy coincides
+                copy.name = "Duplicate of wall"
+                scene.collection.objects.link(copy)
+            self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
+            values = np.concatenate([attribute(o) for o in bake.result_objects(scene)])
+            return scene.radiosity.stats.warning, luminance(values).mean(), wall.name
+
+        single_warning, single, _ = solve(False)
+        doubled_warning, doubled, name = solve(True)
+        self.assertNotIn("same place", single_warning)
+        self.assertIn("faces in the same place, counted once: Duplicate of wall and %s" % name, doubled_warning)
+        self.assertLess(abs(doubled / single - 1), 0.01)
+
+
 class VisibilityHintTest(unittest.TestCase):
     def test_slow_exact_linking_suggests_sampled_visibility(self):
         hint = operators.visibility_hint("exact", {"seconds_linking": 42.0})
