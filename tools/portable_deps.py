@@ -135,7 +135,6 @@ def sources(folder):
         for tarball in sum(tarballs.values(), []):
             subprocess.run(["tar", "-xf", str(tarball), "-C", str(folder / "src")], check=True)
         embree = next((folder / "src").glob("embree-*"))
-        (embree / "readme.pdf").touch()   # installed by Embree's CMake, left out of Debian's tarball
         for rel, (old, new) in EMBREE_FIXES.items():
             path = embree / rel
             text = path.read_text()
@@ -150,6 +149,8 @@ def build_static(folder, name, source, options):
     key = " ".join(options)
     if done(folder, name, key):
         return
+    if name == "embree":
+        (source / "readme.pdf").touch()   # installed by Embree's CMake, left out of Debian's tarball
     log("building %s (static, %s); this takes minutes" % (name, TARGET))
     start = time.perf_counter()
     work = folder / ("build-" + name)
