@@ -58,6 +58,26 @@ def positions(obj):
     return co.reshape(-1, 3)
 
 
+def values_at(obj, points):
+    """(N, 3) attribute values of a planar z-up mesh interpolated at the (N, 2)
+    points (x, y), linearly over each polygon's fan of triangles: what a render
+    shows there, however the mesh is cut. NaN where no polygon covers a point."""
+    p, v = positions(obj), attribute(obj)
+    out = np.full((len(points), 3), np.nan)
+    for poly in obj.data.polygons:
+        idx = list(poly.vertices)
+        for k in range(1, len(idx) - 1):
+            a, b, c = p[idx[0], :2], p[idx[k], :2], p[idx[k + 1], :2]
+            m = np.array([b - a, c - a]).T
+            if abs(np.linalg.det(m)) < 1e-14:
+                continue
+            uv = np.linalg.solve(m, (points - a).T).T
+            w = np.column_stack([1 - uv.sum(axis=1), uv])
+            hit = np.all(w >= -1e-9, axis=1) & np.isnan(out[:, 0])
+            out[hit] = w[hit] @ v[[idx[0], idx[k], idx[k + 1]]]
+    return out
+
+
 def results(scene):
     return {o[export.RESULT_TAG]: o for o in bake.result_objects(scene)}
 
@@ -123,18 +143,22 @@ class SolveCubeTest(unittest.TestCase):
         bpy.ops.radiosity.solve()
         out = results(scene)
         floor = out["Floor"]
-        p, v = positions(floor), luminance(attribute(floor))
         # The small cube stands at (0.3, 0.05) turned 20 degrees; right next to
         # it, away from the light, the floor is in its shadow; under the light
         # (x, y near 0, cube's left side) and far in the open it is lit.
+        # Compared where a render would: at points, interpolated, so that how
+        # the floor is cut does not decide which points are looked at.
         cube = scene.objects["Cube"]
         centre = np.array(cube.location[:2])
-        d = np.linalg.norm(p[:, :2] - centre, axis=1)
-        away = (p[:, :2] - centre) @ (centre / np.linalg.norm(centre))
-        shadow = (d > 0.36) & (d < 0.45) & (away > 0.3)
-        lit = np.linalg.norm(p[:, :2] - [-0.3, -0.3], axis=1) < 0.15
-        self.assertTrue(shadow.any() and lit.any())
-        self.assertGreater(v[lit].mean(), 1.5 * v[shadow].mean())
+        grid = np.stack(np.meshgrid(np.linspace(-1, 1, 81), np.linspace(-1, 1, 81)), axis=-1).reshape(-1, 2)
+        d = np.linalg.norm(grid - centre, axis=1)
+        away = (grid - centre) @ (centre / np.linalg.norm(centre))
+        shadow = grid[(d > 0.36) & (d < 0.45) & (away > 0.3)]
+        lit = grid[np.linalg.norm(grid - [-0.3, -0.3], axis=1) < 0.15]
+        v_shadow, v_lit = luminance(values_at(floor, shadow)), luminance(values_at(floor, lit))
+        self.assertTrue(len(shadow) > 5 and len(lit) > 5)
+        self.assertFalse(np.isnan(v_shadow).any() or np.isnan(v_lit).any(), "the floor has holes")
+        self.assertGreater(v_lit.mean(), 1.5 * v_shadow.mean())
         # The cube's top (facing the light) is brighter than its sides.
         cube_out = out["Cube"]
         cp, cv = positions(cube_out), luminance(attribute(cube_out))

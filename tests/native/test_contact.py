@@ -138,6 +138,23 @@ class Meshing(unittest.TestCase):
         # The floor under the box coincides with the box's bottom: one surface there.
         self.assertEqual(len(scene.coincident_faces), 1)
 
+    def test_legs_under_five_per_cent_of_the_floor_are_not_cut_around_unless_they_emit(self):
+        # A 4 x 4 floor (diameter 5.66 m): 5 % is 28 cm. A 20 cm block stands
+        # on it uncut; a 40 cm one, or a 20 cm lamp lying on it, is cut around.
+        def floor_with(size, emits):
+            b = SceneBuilder()
+            b.polygon([(0, 0, 0), (4, 0, 0), (4, 4, 0), (0, 4, 0)], rho=0.5)
+            b.polygon([(1, 3, 3), (3, 3, 3), (3, 1, 3), (1, 1, 3)], rho=0.0, emission=5.0, two_sided=False)
+            if emits:
+                b.polygon([(2, 2, 0.001), (2 + size, 2, 0.001), (2 + size, 2 + size, 0.001), (2, 2 + size, 0.001)],
+                          rho=0.0, emission=5.0, two_sided=False)
+            else:
+                b.box((2, 2, 0), (2 + size, 2 + size, 0.5), rho=0.5, skip=(0,))  # no bottom
+            return b.scene(rad)
+        self.assertEqual(floor_with(0.2, emits=False).split_faces, 0)
+        self.assertGreaterEqual(floor_with(0.4, emits=False).split_faces, 1)
+        self.assertGreaterEqual(floor_with(0.2, emits=True).split_faces, 1)
+
     def test_a_doubled_wall_counts_once_and_is_named(self):
         def room(doubled):
             b = SceneBuilder()
