@@ -219,18 +219,32 @@ bool finish(const LinkEvaluator& evaluator, Link& link, const LinkEnds& ends, Sa
   // edge a slope set by the emitter's width, steep for thin emitters (a table
   // leg on the floor). No element size makes the radiance linear there, so the
   // oracle judges the element by its other samples; the sample still gathers.
+  // The same next to an occluder touching the receiver (a box's wall at its
+  // foot on the floor, a leg under a table top): the shadow's edge starts at
+  // the sample, whose gradient is then near-singular.
   const auto start = Clock::now();
   const double contact = 1e-5 * hierarchy.diameter(receiver);
   dvec3 oracle_x[kMaxSamples], oracle_grad[kMaxSamples];
   double oracle_value[kMaxSamples];
+  bool at_emitter[kMaxSamples], at_occluder[kMaxSamples];
+  int clear = 0;
+  for (int s = 0; s < ends.ns; ++s) {
+    at_emitter[s] = at_occluder[s] = false;
+    for (int k = 0; k < ends.ne; ++k) {
+      at_emitter[s] |= distance_to_segment(ends.x[s], ends.emitter_corners[k],
+                                           ends.emitter_corners[(k + 1) % ends.ne]) < contact;
+    }
+    for (size_t t = 0; t < candidates.size() && !at_emitter[s] && !at_occluder[s]; ++t)
+      at_occluder[s] = distance_to_polygon(ends.x[s], candidates[t].v) < contact;
+    clear += at_emitter[s] || at_occluder[s] ? 0 : 1;
+  }
+  // An element whose corners all touch occluders (a floor between two walls
+  // standing on it) is still judged by them: by its centre alone it would
+  // never refine.
+  const bool skip_occluder_contacts = clear >= 2;
   size_t used = 0;
   for (int s = 0; s < ends.ns; ++s) {
-    bool touching = false;
-    for (int k = 0; k < ends.ne; ++k) {
-      touching |= distance_to_segment(ends.x[s], ends.emitter_corners[k],
-                                      ends.emitter_corners[(k + 1) % ends.ne]) < contact;
-    }
-    if (touching) continue;
+    if (at_emitter[s] || (at_occluder[s] && skip_occluder_contacts)) continue;
     oracle_x[used] = ends.x[s];
     oracle_value[used] = std::max(0.0, value[s]);
     oracle_grad[used] = grad[s];
