@@ -174,6 +174,7 @@ OutputMesh make_output_mesh(const Hierarchy& h,
 
   // Radiance at pool vertices: the mean over the leaves that have it as a corner.
   std::vector<glm::dvec3> sum(h.vertex_count(), glm::dvec3(0.0));
+  std::vector<glm::dvec3> sum_h(h.vertex_count(), glm::dvec3(0.0));  // the same before rho and L_e
   std::vector<std::uint32_t> count(h.vertex_count(), 0);
   for (size_t i = 0; i < elements.size(); ++i) {
     const Element& e = elements[i];
@@ -182,23 +183,28 @@ OutputMesh make_output_mesh(const Hierarchy& h,
     for (int k = 0; k < e.corner_count; ++k) {
       // Energy-conserving link corrections (link_transport.cpp) may leave a
       // sample a rounding below zero; light is never negative.
-      const Rgb value = emission + rho * glm::max(leaf_irradiance[i][static_cast<size_t>(k)], Rgb(0.0));
-      sum[e.corner[static_cast<size_t>(k)]] += glm::dvec3(value);
+      const Rgb gathered = glm::max(leaf_irradiance[i][static_cast<size_t>(k)], Rgb(0.0));
+      sum[e.corner[static_cast<size_t>(k)]] += glm::dvec3(emission + rho * gathered);
+      sum_h[e.corner[static_cast<size_t>(k)]] += glm::dvec3(gathered);
       ++count[e.corner[static_cast<size_t>(k)]];
     }
   }
 
   OutputMesh mesh;
+  const auto append = [](std::vector<float>& out, const glm::dvec3& value) {
+    out.insert(out.end(), {static_cast<float>(value.x), static_cast<float>(value.y), static_cast<float>(value.z)});
+  };
+  const auto mean_of = [&](const std::vector<glm::dvec3>& sums, std::uint32_t v) {
+    return count[v] ? sums[v] / static_cast<double>(count[v]) : glm::dvec3(0.0);
+  };
   std::vector<std::int32_t> remap(h.vertex_count(), kNone);
   const auto output_vertex = [&](std::uint32_t v) {
     if (remap[v] == kNone) {
       remap[v] = static_cast<std::int32_t>(mesh.positions.size() / 3);
       const dvec3& p = h.vertex(v);
       mesh.positions.insert(mesh.positions.end(), {p.x, p.y, p.z});
-      const glm::dvec3 value = count[v] ? sum[v] / static_cast<double>(count[v]) : glm::dvec3(0.0);
-      mesh.radiance.insert(mesh.radiance.end(), {static_cast<float>(value.x),
-                                                 static_cast<float>(value.y),
-                                                 static_cast<float>(value.z)});
+      append(mesh.radiance, mean_of(sum, v));
+      append(mesh.vertex_irradiance, mean_of(sum_h, v));
     }
     return remap[v];
   };
@@ -213,13 +219,10 @@ OutputMesh make_output_mesh(const Hierarchy& h,
   const auto interpolated_vertex = [&](std::uint32_t v, std::uint32_t a, std::uint32_t b) {
     const dvec3 p = h.vertex(v), pa = h.vertex(a), ab = h.vertex(b) - pa;
     const double t = std::clamp(glm::dot(p - pa, ab) / glm::dot(ab, ab), 0.0, 1.0);
-    const auto value = [&](std::uint32_t u) {
-      return count[u] ? sum[u] / static_cast<double>(count[u]) : glm::dvec3(0.0);
-    };
-    const glm::dvec3 l = (1 - t) * value(a) + t * value(b);
     const auto index = static_cast<std::int32_t>(mesh.positions.size() / 3);
     mesh.positions.insert(mesh.positions.end(), {p.x, p.y, p.z});
-    mesh.radiance.insert(mesh.radiance.end(), {static_cast<float>(l.x), static_cast<float>(l.y), static_cast<float>(l.z)});
+    append(mesh.radiance, (1 - t) * mean_of(sum, a) + t * mean_of(sum, b));
+    append(mesh.vertex_irradiance, (1 - t) * mean_of(sum_h, a) + t * mean_of(sum_h, b));
     return index;
   };
   std::vector<std::uint32_t> edge, between;

@@ -18,6 +18,10 @@ struct OutputMesh {
   std::vector<std::int32_t> face_vertices;  // polygons' vertices, concatenated
   std::vector<std::int32_t> face_sizes;     // per polygon
   std::vector<float> radiance;            // 3 per vertex
+  // Per vertex: the gathered H (irradiance / pi) before the surface's own
+  // reflectance and emission, so radiance = L_e + rho H; what a lighting-only
+  // bake multiplies a textured material's colour by.
+  std::vector<float> vertex_irradiance;   // 3 per vertex
   std::vector<std::int32_t> source_face;  // per polygon: the input face
   std::vector<std::uint8_t> source_side;  // per polygon: 0 front, 1 back
   // Per polygon: area average of the gathered H (irradiance / pi) over the

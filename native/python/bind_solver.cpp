@@ -80,7 +80,7 @@ py::array_t<T> hand_over(std::vector<T>&& v, std::vector<py::ssize_t> shape) {
 struct PyResult {
   py::array_t<double> positions;
   py::array_t<std::int32_t> face_vertices, face_sizes, source_face;
-  py::array_t<float> radiance;
+  py::array_t<float> radiance, vertex_irradiance;
   py::array_t<std::uint8_t> source_side;
   py::array_t<float> irradiance;
   py::dict stats;
@@ -129,6 +129,7 @@ PyResult to_python(SolveResult&& r) {
   const auto corners = static_cast<py::ssize_t>(m.face_vertices.size());
   out.positions = hand_over(std::move(m.positions), {vertices, 3});
   out.radiance = hand_over(std::move(m.radiance), {vertices, 3});
+  out.vertex_irradiance = hand_over(std::move(m.vertex_irradiance), {vertices, 3});
   out.face_vertices = hand_over(std::move(m.face_vertices), {corners});
   out.face_sizes = hand_over(std::move(m.face_sizes), {polygons});
   out.source_face = hand_over(std::move(m.source_face), {polygons});
@@ -286,6 +287,9 @@ void bind_solver(py::module_& m) {
       .def_readonly("face_vertices", &PyResult::face_vertices, "polygons' vertex indices, concatenated")
       .def_readonly("face_sizes", &PyResult::face_sizes, "(P,) vertices per polygon")
       .def_readonly("radiance", &PyResult::radiance, "(V, 3) float32 radiance per vertex")
+      .def_readonly("vertex_irradiance", &PyResult::vertex_irradiance,
+                    "(V, 3) float32 gathered radiance H per vertex (irradiance / pi), before the surface's "
+                    "reflectance and emission: radiance = emission + reflectance * H")
       .def_readonly("source_face", &PyResult::source_face, "(P,) input face of each polygon")
       .def_readonly("source_side", &PyResult::source_side, "(P,) 0 front, 1 back")
       .def_readonly("irradiance", &PyResult::irradiance,
