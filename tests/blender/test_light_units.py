@@ -219,11 +219,15 @@ class LightUnitsTest(unittest.TestCase):
                      np.round(factor * 4 * math.pi ** 2, 4)), flush=True)
             remove(light.name)
 
-    def near_point(self, kind, radius, distance, samples=128, label=None, **settings):
-        """A point (or downward spot) light of `radius` at `distance` above the plane;
-        compares the centre pixels with the version's shape and prints both shapes' ratios."""
+    def near_point(self, kind, radius, distance, samples=128, label=None, scale=1.0, **settings):
+        """A point (or downward spot) light of `radius` at `distance` above the plane, its
+        object scaled by `scale`; compares the centre pixels with the version's shape (of the
+        unscaled radius) and prints both shapes' ratios."""
         power = 100.0
         light = self.light(kind, (0, 0, distance), energy=power, radius=radius, **settings)
+        if scale != 1.0:
+            bpy.data.objects[light.name].scale = (scale,) * 3
+            bpy.context.view_layer.update()
         x, y = self.view(0.0, 0.0, 0.5 * distance)
         pixels = self.render(samples)
         soft = getattr(light, "use_soft_falloff", True)
@@ -244,7 +248,8 @@ class LightUnitsTest(unittest.TestCase):
             else:
                 h = light_units.point_light_h(conv["intensity"][0], radius, shape, d, cos)
             ratios[shape] = measured / np.mean(h)
-        label = label or "%s r=%g d=%g soft_falloff=%s" % (kind.lower(), radius, distance, soft)
+        label = label or "%s r=%g d=%g soft_falloff=%s%s" % (
+            kind.lower(), radius, distance, soft, " object scale %g" % scale if scale != 1.0 else "")
         print("[measure] Blender %s, %s: measured / sphere model = %.4f, / disk model = %.4f (%s)"
               % (bpy.app.version_string, label, ratios['SPHERE'], ratios['DISK'], conv["shape"]),
               flush=True)
@@ -255,6 +260,8 @@ class LightUnitsTest(unittest.TestCase):
         self.near_point('POINT', 0.25, 0.5)
         self.near_point('POINT', 0.25, 0.75)
         self.near_point('POINT', 0.1, 0.2)
+        # The object's scale changes neither the radius nor the intensity.
+        self.near_point('POINT', 0.25, 0.5, scale=2.0)
 
     def test_point_radius_hard_falloff(self):
         self.require('POINT', "use_soft_falloff")
@@ -300,6 +307,8 @@ class LightUnitsTest(unittest.TestCase):
                                                  (29, 29.8), (31, 40)])
         # 90 degrees, blend 1: the band spans the whole cone (cos 0.7071 to 1)
         self.spot(math.radians(90.0), 1.0, 2.4, [(0, 2), (15, 20), (30, 32), (40, 44), (46, 50)])
+        # blend 0: a step at 30 degrees
+        self.spot(math.radians(60.0), 0.0, 1.8, [(10, 18), (27, 29.7), (30.3, 40)])
 
     def test_spot_radius(self):
         self.near_point('SPOT', 0.25, 0.5, spot_size=math.radians(90.0), spot_blend=0.5)
