@@ -16,9 +16,11 @@ units) and shows L = L_e + rho H. The functions below turn a light's Blender set
     world (uniform)          H = world_radiance on a surface open to the whole sky
 
 d is the distance to the light's centre, theta the angle of incidence at the receiver.
-The radius is Blender's `shadow_soft_size`, in metres, in every version (object scale is
-not applied; not measured). 'DISK' is a disk of that radius that always faces the
-receiver and emits radiance L = I / r^2; 'SPHERE' a sphere of that radius emitting L.
+The radius is Blender's `shadow_soft_size`, in metres, in every version; the object's
+(uniform) scale changes neither it nor the intensity (measured). A spot's non-uniform
+scale, which Cycles 4.x uses to squash the cone, is not modelled. 'DISK' is a disk of
+that radius that always faces the receiver and emits radiance L = I / r^2; 'SPHERE' a
+sphere of that radius emitting L.
 
 Measured in Cycles, not recalled (tests/blender/test_light_units.py, which runs in every
 tested Blender and prints these numbers as `[measure]` lines): a white Diffuse BSDF plane,
@@ -28,20 +30,24 @@ per pixel and the means over pixel sets compared.
 
     quantity (power P, strength S)      Blender 3.4.1           4.5.15 and 5.0.1
     point, r = 0: 4 pi^2 I / P          1.0000 (d = 1, 2; normal and 35-42 deg incidence)
-    point, r > 0, measured / DISK       1.0000 (r 0.25 at d = 0.5, 0.75; r 0.1 at d = 0.2)
-                  measured / SPHERE     0.8031 (d = 2r), 0.9017 (d = 3r): the disk
+    point, r > 0, measured / DISK       1.0000 (r 0.25 at d = 0.5, 0.75; r 0.1 at d = 0.2;
+                                        r 0.25 with object scale 2: scale changes nothing)
+                  measured / SPHERE     0.8031 (d = 2r), 0.9018 (d = 3r): the disk
     point, soft falloff off             -                       / SPHERE 1.0000,
                                                                 / DISK 1.2452 (2r), 1.1090 (3r)
     spot, r 0.25 at d = 0.5 / its shape 1.0000 (DISK)           1.0000 (DISK; SPHERE w/o soft falloff)
     spot attenuation                    cos x smoothstep        smoothstep (no cosine)
       60 deg blend 0.3 at 10-18 deg     0.9679 (= mean cos)     1.0000
-      in the band, 25.5-26.5 deg        0.8061                  0.8970
+      in the band, 25.5-26.5 deg        0.8061                  0.8970 (5.0.1: 0.8971)
       27-28.5 deg                       0.4006                  0.4523
+      29-29.8 deg                       0.0471                  0.0540 (5.0.1: 0.0542)
       outside (31-40 deg)               0                       0
+      90 deg blend 1 at 30-32 deg       0.4478                  0.5219
+      60 deg blend 0 at 27-29.7 deg     0.8801 (cos)            1.0000 (a step)
     sun: pi H / (S cos theta)           2c / (1 + c),           1.0000 (angles 0, 10, 90 deg;
                                         c = cos(angle / 2):     tilts 0, 30, 60 deg)
                                         0.9981 at 10 deg, 0.96891 at 40 deg,
-                                        0.82843 at 90 deg, 0.2959 at 160 deg
+                                        0.8284 at 90 deg (tilt 30), 0.2959 at 160 deg
     world: H / (colour x strength)      1.0000                  1.0000
     exposure e                          (none)                  x 2^e (point 1.5, sun -1)
     normalize off                       (none)                  r = 0: I = P / pi^2 (x 4);
@@ -49,13 +55,20 @@ per pixel and the means over pixel sets compared.
                                                                 sun: H = S sin^2(angle / 2)
     temperature (use_temperature)       (none)                  colour x temperature_color
 
+(every "measured / predicted" of the test is 1.0000 but for the noisy lights with a
+radius, 0.9998 to 1.0002, and the 5.0.1 spot's last 0.2 deg before the cone's edge, 1.0045.)
+
 So I = P / (4 pi^2) for a point or spot light (on the spot's axis) in all three, with or
 without a radius: the power is divided by nothing that depends on the radius (the radiance
 of a light with radius is L = P / (4 pi^2 r^2)), and the radius only changes the shape's
-near field. This is Cycles' eval_fac = 1 / (pi A), A = 4 pi r^2 (4 when r = 0), read in
-intern/cycles/scene/light.cpp (blender/blender main, which also shows `is_sphere` =
-not use_soft_falloff) and kernel/light/point.h, spot.h; kernel/light/light.h and common.h
-of 3.x for `spot_light_attenuation` with its extra cosine. The measurements decide.
+near field. Source read (the measurements decide): Cycles' intern/cycles/scene/light.cpp
+of a 4.x with `normalize` (eval_fac = 1 / (pi A), A = 4 pi r^2 or 4 when r = 0;
+the sun's 1 / (pi sin^2(angle / 2)); spot_smooth = 1 / ((1 - c0) blend)),
+kernel/light/point.h and spot.h of blender/blender main (a sphere where the kernel's
+`is_sphere` is set, else a disk facing the receiver; spot attenuation smoothstepf((cos -
+c0) spot_smooth), no cosine), and a 3.x kernel/light/common.h `spot_light_attenuation`
+(attenuation = cos, times smoothstepf(t / spot_smooth) in the band); none pinned to the
+exact 3.4 / 4.5 / 5.0 commits. That `is_sphere` is "soft falloff off" is measured.
 """
 
 import math
