@@ -31,10 +31,12 @@ per pixel and the means over pixel sets compared.
     quantity (power P, strength S)      Blender 3.4.1           4.5.15 and 5.0.1
     point, r = 0: 4 pi^2 I / P          1.0000 (d = 1, 2; normal and 35-42 deg incidence)
     point, r > 0, measured / DISK       1.0000 (r 0.25 at d = 0.5, 0.75; r 0.1 at d = 0.2;
-                                        r 0.25 with object scale 2: scale changes nothing)
+                                        r 0.25 at d = 0.5 and 35 deg incidence (/ SPHERE
+                                        0.8555); r 0.25 with object scale 2: unchanged)
                   measured / SPHERE     0.8031 (d = 2r), 0.9018 (d = 3r): the disk
     point, soft falloff off             -                       / SPHERE 1.0000,
-                                                                / DISK 1.2452 (2r), 1.1090 (3r)
+                                                                / DISK 1.2452 (2r), 1.1090 (3r),
+                                                                1.1690 (2r, 35 deg incidence)
     spot, r 0.25 at d = 0.5 / its shape 1.0000 (DISK)           1.0000 (DISK; SPHERE w/o soft falloff)
     spot attenuation                    cos x smoothstep        smoothstep (no cosine)
       60 deg blend 0.3 at 10-18 deg     0.9679 (= mean cos)     1.0000

@@ -11,8 +11,9 @@ for lights of radius 0, the sun and the world (deterministic: a few samples), wi
 2 % for lights with a radius (128 samples, noise about 0.1 %). Cases:
 
     point, r = 0, d = 1 and 2: normal incidence and 35-42 deg (inverse square, cosine)
-    point, r 0.25 at d = 0.5 (2r) and 0.75 (3r), r 0.1 at d = 0.2: 'DISK' vs 'SPHERE'
-    point with use_soft_falloff off (4.x), at 2r and 3r
+    point, r 0.25 at d = 0.5 (2r) and 0.75 (3r), r 0.1 at d = 0.2: 'DISK' vs 'SPHERE';
+    r 0.25 at d = 0.5 at 35 deg incidence, and with object scale 2
+    point with use_soft_falloff off (4.x), at 2r, 3r and 2r at 35 deg incidence
     spot 60 deg blend 0.3 and 90 deg blend 1 at the axis, inside, across the blend band,
     outside; a spot of radius 0.25 at d = 0.5 (both falloffs), predicted by integrating the
     attenuation over the directions the light's disk or sphere covers (cone_h)
@@ -219,16 +220,17 @@ class LightUnitsTest(unittest.TestCase):
                      np.round(factor * 4 * math.pi ** 2, 4)), flush=True)
             remove(light.name)
 
-    def near_point(self, kind, radius, distance, samples=128, label=None, scale=1.0, **settings):
+    def near_point(self, kind, radius, distance, samples=128, label=None, scale=1.0, offset=0.0,
+                   **settings):
         """A point (or downward spot) light of `radius` at `distance` above the plane, its
-        object scaled by `scale`; compares the centre pixels with the version's shape (of the
-        unscaled radius) and prints both shapes' ratios."""
+        object scaled by `scale`; compares the pixels around (offset, 0) with the version's
+        shape (of the unscaled radius) and prints both shapes' ratios."""
         power = 100.0
         light = self.light(kind, (0, 0, distance), energy=power, radius=radius, **settings)
         if scale != 1.0:
             bpy.data.objects[light.name].scale = (scale,) * 3
             bpy.context.view_layer.update()
-        x, y = self.view(0.0, 0.0, 0.5 * distance)
+        x, y = self.view(offset, 0.0, 0.5 * distance)
         pixels = self.render(samples)
         soft = getattr(light, "use_soft_falloff", True)
         if kind == 'SPOT':
@@ -236,7 +238,7 @@ class LightUnitsTest(unittest.TestCase):
                                           light.spot_blend, soft_falloff=soft)
         else:
             conv = light_units.point_light(VERSION, power, (1, 1, 1), radius, soft_falloff=soft)
-        mask = np.hypot(x, y) < 0.2 * distance
+        mask = np.hypot(x - offset, y) < 0.2 * distance
         mask[1::2, :] = mask[:, 1::2] = False   # every other pixel: cone_h is slow
         d, cos = self.point_geometry(x[mask], y[mask], distance)
         measured = pixels[mask].mean()
@@ -250,6 +252,8 @@ class LightUnitsTest(unittest.TestCase):
             ratios[shape] = measured / np.mean(h)
         label = label or "%s r=%g d=%g soft_falloff=%s%s" % (
             kind.lower(), radius, distance, soft, " object scale %g" % scale if scale != 1.0 else "")
+        if offset:
+            label += " at %.0f deg incidence" % math.degrees(math.atan2(offset, distance))
         print("[measure] Blender %s, %s: measured / sphere model = %.4f, / disk model = %.4f (%s)"
               % (bpy.app.version_string, label, ratios['SPHERE'], ratios['DISK'], conv["shape"]),
               flush=True)
@@ -262,11 +266,13 @@ class LightUnitsTest(unittest.TestCase):
         self.near_point('POINT', 0.1, 0.2)
         # The object's scale changes neither the radius nor the intensity.
         self.near_point('POINT', 0.25, 0.5, scale=2.0)
+        self.near_point('POINT', 0.25, 0.5, offset=0.35)
 
     def test_point_radius_hard_falloff(self):
         self.require('POINT', "use_soft_falloff")
         self.near_point('POINT', 0.25, 0.5, use_soft_falloff=False)
         self.near_point('POINT', 0.1, 0.3, use_soft_falloff=False)
+        self.near_point('POINT', 0.25, 0.5, offset=0.35, use_soft_falloff=False)
 
     # --- spot lights ----------------------------------------------------------------
 
