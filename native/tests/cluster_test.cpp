@@ -34,7 +34,7 @@ struct Arrays {
     emission.insert(emission.end(), {emit, emit, emit});
     two_sided.push_back(both_sides ? 1 : 0);
   }
-  Scene scene() const { return make_scene({positions, faces, sizes, reflectance, emission, two_sided, {}}); }
+  Scene scene() const { return make_scene({positions, faces, sizes, reflectance, emission, two_sided, {}, {}, {}}); }
 };
 
 // A grid of n x n small squares at height z, facing up or down.

@@ -20,7 +20,7 @@ Scene floor_and_wall(double gap) {
   const std::vector<double> reflectance = {0.5, 0.5, 0.5, 0.5, 0.5, 0.5};
   const std::vector<double> emission = {1, 1, 1, 0, 0, 0};
   const std::vector<std::uint8_t> two_sided = {0, 0};
-  return make_scene({positions, faces, sizes, reflectance, emission, two_sided, {}});
+  return make_scene({positions, faces, sizes, reflectance, emission, two_sided, {}, {}, {}});
 }
 
 // Splits every leaf of `root` `levels` times.
