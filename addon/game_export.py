@@ -1,0 +1,264 @@
+"""Game-ready output (Blender glue; the colour math is display_colours.py).
+
+With `scene.radiosity.display_colours` on, a solve bakes display-ready colours
+(exposure, the scene's view transform, clamped to [0, 1]; display_colours.py
+says why they are stored linear) and gives the result meshes the "Radiosity
+Unlit" material instead of "Radiosity Emission". Blender's glTF exporter
+(io_scene_gltf2, 3.4 to 5.0) writes that material as KHR_materials_unlit with
+the colour attribute as COLOR_0: it recognises an unlit material by the shape
+of its node tree, from the output node back:
+
+    [Geometry Backfacing] -> [1 - x] -> [Mix Fac]          "mix-alpha": alpha = front
+    [Transparent BSDF] ------------------> [Mix Shader 1]
+    [Light Path Is Camera Ray] -> [Mix Fac] -> [Mix Shader 2] -> [Material Output]
+    [Transparent BSDF] -----------> [Mix Shader 1]          "light path trick"
+    [Color Attribute] -> [Emission] -> [Mix Shader 2]       the colour
+
+Both mixes are optional to the exporter; the light path trick alone marks the
+material unlit. The emission's colour comes from a Color Attribute node naming
+"Radiosity", which the 4.x exporter (export_vertex_color 'MATERIAL') follows
+to decide which attribute becomes COLOR_0; 3.4 exports the render colour
+attribute, which "Radiosity" is. The colour is not a constant, so the base
+colour factor stays white and COLOR_0 alone colours the surface.
+
+Back faces: each side of a two-sided face is its own polygon, so the
+material is one-sided: backface culling on (EEVEE and the viewport skip back
+faces; glTF gets doubleSided false, so engines cull them too and each side of
+a wall shows its own light) and, for Cycles, which ignores culling, the
+Backfacing mix makes back faces transparent. The mix-alpha's factor is not a
+constant, so the exporters write no alpha (alphaMode OPAQUE).
+
+`radiosity.export_gltf` writes the result objects alone to a .glb or .gltf
+(selects them, calls the exporter with the options its version has, restores
+the selection).
+"""
+
+import os
+
+import bpy
+from bpy.props import BoolProperty, StringProperty
+from bpy.types import Operator
+from bpy_extras.io_utils import ExportHelper
+
+from . import bake, display_colours
+
+UNLIT_MATERIAL_NAME = "Radiosity Unlit"
+UNLIT_TAG = "radiosity_unlit_material"
+
+
+def unlit_material():
+    """The shared material that shows the "Radiosity" attribute unlit, one-sided."""
+    for mat in bpy.data.materials:
+        if mat.get(UNLIT_TAG):
+            return mat
+    mat = bpy.data.materials.new(UNLIT_MATERIAL_NAME)
+    mat[UNLIT_TAG] = True
+    mat.use_nodes = True
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    nodes.clear()
+    colour = nodes.new("ShaderNodeVertexColor")
+    colour.layer_name = bake.ATTRIBUTE
+    colour.location = (-700, 0)
+    emission = nodes.new("ShaderNodeEmission")
+    emission.inputs["Strength"].default_value = 1.0
+    emission.location = (-450, 0)
+    light_path = nodes.new("ShaderNodeLightPath")
+    light_path.location = (-450, 450)
+    hidden = nodes.new("ShaderNodeBsdfTransparent")
+    hidden.location = (-450, 100)
+    camera_mix = nodes.new("ShaderNodeMixShader")
+    camera_mix.location = (-200, 100)
+    backfacing = nodes.new("ShaderNodeNewGeometry")
+    backfacing.location = (-450, 700)
+    front = nodes.new("ShaderNodeMath")
+    front.operation = 'SUBTRACT'
+    front.inputs[0].default_value = 1.0
+    front.location = (-200, 500)
+    back = nodes.new("ShaderNodeBsdfTransparent")
+    back.location = (-200, 250)
+    side_mix = nodes.new("ShaderNodeMixShader")
+    side_mix.location = (50, 250)
+    output = nodes.new("ShaderNodeOutputMaterial")
+    output.location = (300, 250)
+    links.new(colour.outputs["Color"], emission.inputs["Color"])
+    links.new(light_path.outputs["Is Camera Ray"], camera_mix.inputs["Fac"])
+    links.new(hidden.outputs["BSDF"], camera_mix.inputs[1])
+    links.new(emission.outputs["Emission"], camera_mix.inputs[2])
+    links.new(backfacing.outputs["Backfacing"], front.inputs[1])
+    links.new(front.outputs["Value"], side_mix.inputs["Fac"])
+    links.new(back.outputs["BSDF"], side_mix.inputs[1])
+    links.new(camera_mix.outputs["Shader"], side_mix.inputs[2])
+    links.new(side_mix.outputs["Shader"], output.inputs["Surface"])
+    mat.use_backface_culling = True
+    if hasattr(mat, "blend_method"):
+        # Opaque to EEVEE Legacy (its culling hides back faces) and to the glTF
+        # exporter before 4.2, which takes alphaMode from it.
+        mat.blend_method = 'OPAQUE'
+    if hasattr(mat, "shadow_method"):
+        mat.shadow_method = 'NONE'
+    mat.diffuse_color = (1.0, 1.0, 1.0, 1.0)
+    return mat
+
+
+def is_game_ready(obj):
+    """Whether a result object was baked with game-ready colours."""
+    mesh = obj.data
+    return (mesh is not None and len(mesh.materials) > 0
+            and all(m is not None and m.get(UNLIT_TAG) for m in mesh.materials))
+
+
+# --- The scene's view as display settings ------------------------------------------------
+
+def ocio_config_path():
+    """The OpenColorIO config Blender uses: $OCIO, else its own."""
+    env = os.environ.get("OCIO")
+    if env and os.path.isfile(env):
+        return env
+    path = bpy.utils.system_resource('DATAFILES', path=os.path.join("colormanagement", "config.ocio"))
+    if path and os.path.isfile(path):
+        return path
+    path = os.path.join(bpy.utils.resource_path('LOCAL'), "datafiles", "colormanagement", "config.ocio")
+    return path if os.path.isfile(path) else ""
+
+
+def display_settings(scene):
+    """(DisplaySettings, note) for the scene: the add-on's exposure plus the view's,
+    the view transform, its look and gamma; the note says when the view needs
+    OpenColorIO that this Blender's Python lacks (Standard is used then)."""
+    view = scene.view_settings
+    settings = display_colours.DisplaySettings(
+        exposure=scene.radiosity.display_exposure + view.exposure,
+        view=view.view_transform, gamma=view.gamma)
+    if settings.view in (display_colours.STANDARD,) + display_colours.RAW_VIEWS:
+        return settings, ""
+    settings.transform = display_colours.ocio_display(
+        ocio_config_path(), scene.display_settings.display_device, settings.view, view.look)
+    if settings.transform is not None:
+        return settings, ""
+    why = ("this Blender's Python has no PyOpenColorIO" if not display_colours.ocio_available()
+           else "OpenColorIO could not build it (look %r)" % view.look)
+    return settings, ("game-ready colours use the Standard view transform instead of %r: %s"
+                      % (settings.view, why))
+
+
+def bake_options(scene):
+    """(convert, material, note) for a game-ready bake: the function turning radiance
+    into the colours written, the unlit material, and a warning or ""."""
+    settings, note = display_settings(scene)
+    return (lambda radiance: display_colours.game_colours(radiance, settings)), unlit_material(), note
+
+
+# --- Export of the result only -----------------------------------------------------------
+
+def gltf_options(operator_properties, filepath):
+    """Keyword arguments for bpy.ops.export_scene.gltf that export the selected result
+    objects with their colour attribute as COLOR_0, chosen by which properties the
+    installed exporter has (3.4: export_colors; 4.x: export_vertex_color and friends)."""
+    props = set(operator_properties)
+    glb = not filepath.lower().endswith(".gltf")
+    wanted = {
+        "filepath": filepath,
+        "export_format": 'GLB' if glb else 'GLTF_SEPARATE',
+        "use_selection": True,
+        "use_visible": False,
+        "use_renderable": False,
+        "use_active_collection": False,
+        "export_materials": 'EXPORT',
+        "export_apply": False,
+        "export_yup": True,
+        "export_cameras": False,
+        "export_lights": False,
+        "export_animations": False,
+        "export_extras": False,
+        # The colour attribute as COLOR_0, not also as a custom _RADIOSITY attribute.
+        "export_attributes": False,
+        "export_colors": True,                      # 3.x
+        "export_vertex_color": 'ACTIVE',            # 4.2+: the active colour attribute
+        "export_all_vertex_colors": False,
+        "export_active_vertex_color_when_no_material": True,
+    }
+    return {k: v for k, v in wanted.items() if k in props}
+
+
+def gltf_exporter_properties():
+    """Names of bpy.ops.export_scene.gltf's properties, enabling io_scene_gltf2 if needed;
+    None when there is no glTF exporter."""
+    for attempt in range(2):
+        try:
+            return [p.identifier for p in bpy.ops.export_scene.gltf.get_rna_type().properties]
+        except (KeyError, AttributeError):
+            if attempt:
+                return None
+            import addon_utils
+            addon_utils.enable("io_scene_gltf2", default_set=True)
+    return None
+
+
+def export_gltf(context, filepath):
+    """Write the result objects of the context's scene to `filepath` (.glb or .gltf).
+    Returns the objects written; raises RuntimeError with a message for the user."""
+    scene, view_layer = context.scene, context.view_layer
+    objects = [o for o in bake.result_objects(scene) if view_layer.objects.get(o.name) is not None]
+    if not objects:
+        raise RuntimeError("No radiosity result to export: solve with output Refined Meshes first")
+    not_ready = [o.name for o in objects if not is_game_ready(o)]
+    if not_ready:
+        raise RuntimeError("The result holds HDR radiance, not display colours: tick Game-Ready "
+                           "Colours and solve again before exporting (%s)" % ", ".join(not_ready[:3]))
+    props = gltf_exporter_properties()
+    if props is None:
+        raise RuntimeError("The glTF exporter (io_scene_gltf2) is not available in this Blender")
+    selected = [o for o in view_layer.objects if o.select_get(view_layer=view_layer)]
+    active = view_layer.objects.active
+    hidden = {}
+    try:
+        for obj in selected:
+            obj.select_set(False, view_layer=view_layer)
+        for obj in objects:
+            # Results hidden by Toggle are still the ones to export.
+            hidden[obj.name] = (obj.hide_viewport, obj.hide_get(view_layer=view_layer))
+            obj.hide_viewport = False
+            obj.hide_set(False, view_layer=view_layer)
+            obj.select_set(True, view_layer=view_layer)
+        view_layer.objects.active = objects[0]
+        options = gltf_options(props, filepath)
+        result = bpy.ops.export_scene.gltf(**options)
+        if 'FINISHED' not in result:
+            raise RuntimeError("The glTF exporter did not finish: %s" % ", ".join(sorted(result)))
+    finally:
+        for obj in objects:
+            obj.select_set(False, view_layer=view_layer)
+            if obj.name in hidden:
+                obj.hide_viewport = hidden[obj.name][0]
+                obj.hide_set(hidden[obj.name][1], view_layer=view_layer)
+        for obj in selected:
+            if view_layer.objects.get(obj.name) is not None:
+                obj.select_set(True, view_layer=view_layer)
+        view_layer.objects.active = active
+    return objects
+
+
+class RADIOSITY_OT_export_gltf(Operator, ExportHelper):
+    """Export the radiosity result objects alone (not the hidden originals) to glTF, with
+    their game-ready colours as COLOR_0 and an unlit material"""
+
+    bl_idname = "radiosity.export_gltf"
+    bl_label = "Export Radiosity glTF"
+    bl_options = {'REGISTER'}
+
+    filename_ext = ".glb"
+    filter_glob: StringProperty(default="*.glb;*.gltf", options={'HIDDEN'})
+    check_extension: BoolProperty(default=False, options={'HIDDEN'})
+
+    @classmethod
+    def poll(cls, context):
+        return context.scene is not None and bool(bake.result_objects(context.scene))
+
+    def execute(self, context):
+        try:
+            objects = export_gltf(context, self.filepath)
+        except RuntimeError as err:
+            self.report({'ERROR'}, str(err))
+            return {'CANCELLED'}
+        self.report({'INFO'}, "Radiosity: %d objects exported to %s" % (len(objects), self.filepath))
+        return {'FINISHED'}
