@@ -5,28 +5,35 @@ With `scene.radiosity.display_colours` on, a solve bakes display-ready colours
 says why they are stored linear) and gives the result meshes the "Radiosity
 Unlit" material instead of "Radiosity Emission". Blender's glTF exporter
 (io_scene_gltf2, 3.4 to 5.0) writes that material as KHR_materials_unlit with
-the colour attribute as COLOR_0: it recognises an unlit material by the shape
-of its node tree, from the output node back:
+the colour attribute as COLOR_0. It recognises an unlit material by the shape
+of its node tree (detect_shadeless_material), from the active Material Output
+back: optionally a "mix-alpha" (Mix Shader with a Transparent BSDF in its first
+shader input, the factor being alpha), then optionally the "light path trick"
+(Mix Shader whose factor is Light Path's Is Camera Ray; its second shader input,
+through an optional Emission node, is the colour), ending at a colour socket:
 
-    [Geometry Backfacing] -> [1 - x] -> [Mix Fac]          "mix-alpha": alpha = front
-    [Transparent BSDF] ------------------> [Mix Shader 1]
-    [Light Path Is Camera Ray] -> [Mix Fac] -> [Mix Shader 2] -> [Material Output]
-    [Transparent BSDF] -----------> [Mix Shader 1]          "light path trick"
-    [Color Attribute] -> [Emission] -> [Mix Shader 2]       the colour
+    [Light Path: Is Camera Ray] -> [Mix Fac]
+    [Transparent BSDF] ----------> [Mix Shader 1] -> [Material Output Surface]
+    [Color Attribute "Radiosity"] -> [Emission] -> [Mix Shader 2]
 
-Both mixes are optional to the exporter; the light path trick alone marks the
-material unlit. The emission's colour comes from a Color Attribute node naming
-"Radiosity", which the 4.x exporter (export_vertex_color 'MATERIAL') follows
-to decide which attribute becomes COLOR_0; 3.4 exports the render colour
-attribute, which "Radiosity" is. The colour is not a constant, so the base
-colour factor stays white and COLOR_0 alone colours the surface.
+(the tree the glTF importer itself builds for an unlit material). The colour
+is not a constant, so the base colour factor stays white and COLOR_0 alone
+colours the surface. Which attribute becomes COLOR_0: 3.4 exports the render
+colour attribute (export_colors); 4.2 and later follow the Color Attribute
+node from the material (export_vertex_color 'MATERIAL'). Other rays than the
+camera's see a Transparent BSDF, so in Cycles the result neither shadows nor
+lights anything (its light is baked in).
 
-Back faces: each side of a two-sided face is its own polygon, so the
-material is one-sided: backface culling on (EEVEE and the viewport skip back
-faces; glTF gets doubleSided false, so engines cull them too and each side of
-a wall shows its own light) and, for Cycles, which ignores culling, the
-Backfacing mix makes back faces transparent. The mix-alpha's factor is not a
-constant, so the exporters write no alpha (alphaMode OPAQUE).
+Back faces: each side of a two-sided face is its own polygon, so the material
+is one-sided by backface culling: EEVEE, the viewport and, through glTF's
+doubleSided false, every engine skip back faces, and each side of a wall shows
+its own light. It has no Backfacing -> transparent mix as "Radiosity Emission"
+has: the 4.2+ exporters take the alpha mode from the mix-alpha's factor and
+would write alphaMode BLEND (a clip, MASK) for it, which engines sort or
+alpha-test; opaque is what a baked level wants. The cost: Cycles, which
+ignores backface culling, shows the back of a one-sided face seen from behind
+(a room's walls from outside) in its front's colour; render with the default
+bake in Cycles.
 
 `radiosity.export_gltf` writes the result objects alone to a .glb or .gltf
 (selects them, calls the exporter with the options its version has, restores
@@ -68,27 +75,13 @@ def unlit_material():
     hidden.location = (-450, 100)
     camera_mix = nodes.new("ShaderNodeMixShader")
     camera_mix.location = (-200, 100)
-    backfacing = nodes.new("ShaderNodeNewGeometry")
-    backfacing.location = (-450, 700)
-    front = nodes.new("ShaderNodeMath")
-    front.operation = 'SUBTRACT'
-    front.inputs[0].default_value = 1.0
-    front.location = (-200, 500)
-    back = nodes.new("ShaderNodeBsdfTransparent")
-    back.location = (-200, 250)
-    side_mix = nodes.new("ShaderNodeMixShader")
-    side_mix.location = (50, 250)
     output = nodes.new("ShaderNodeOutputMaterial")
-    output.location = (300, 250)
+    output.location = (50, 100)
     links.new(colour.outputs["Color"], emission.inputs["Color"])
     links.new(light_path.outputs["Is Camera Ray"], camera_mix.inputs["Fac"])
     links.new(hidden.outputs["BSDF"], camera_mix.inputs[1])
     links.new(emission.outputs["Emission"], camera_mix.inputs[2])
-    links.new(backfacing.outputs["Backfacing"], front.inputs[1])
-    links.new(front.outputs["Value"], side_mix.inputs["Fac"])
-    links.new(back.outputs["BSDF"], side_mix.inputs[1])
-    links.new(camera_mix.outputs["Shader"], side_mix.inputs[2])
-    links.new(side_mix.outputs["Shader"], output.inputs["Surface"])
+    links.new(camera_mix.outputs["Shader"], output.inputs["Surface"])
     mat.use_backface_culling = True
     if hasattr(mat, "blend_method"):
         # Opaque to EEVEE Legacy (its culling hides back faces) and to the glTF
@@ -121,6 +114,24 @@ def ocio_config_path():
     return path if os.path.isfile(path) else ""
 
 
+def import_ocio():
+    """Whether PyOpenColorIO can be imported. Official Blender 4.x and 5.x ship it in
+    their Python; bpy, Blender as a module of another Python, keeps it in its
+    resources (python/lib/pythonX.Y/site-packages), looked in only for this import."""
+    if display_colours.ocio_available():
+        return True
+    import sys
+    bundled = os.path.join(bpy.utils.resource_path('LOCAL'), "python", "lib",
+                           "python%d.%d" % sys.version_info[:2], "site-packages")
+    if not os.path.isdir(os.path.join(bundled, "PyOpenColorIO")):
+        return False
+    sys.path.insert(0, bundled)
+    try:
+        return display_colours.ocio_available()
+    finally:
+        sys.path.remove(bundled)
+
+
 def display_settings(scene):
     """(DisplaySettings, note) for the scene: the add-on's exposure plus the view's,
     the view transform, its look and gamma; the note says when the view needs
@@ -131,6 +142,7 @@ def display_settings(scene):
         view=view.view_transform, gamma=view.gamma)
     if settings.view in (display_colours.STANDARD,) + display_colours.RAW_VIEWS:
         return settings, ""
+    import_ocio()
     settings.transform = display_colours.ocio_display(
         ocio_config_path(), scene.display_settings.display_device, settings.view, view.look)
     if settings.transform is not None:
@@ -173,7 +185,7 @@ def gltf_options(operator_properties, filepath):
         # The colour attribute as COLOR_0, not also as a custom _RADIOSITY attribute.
         "export_attributes": False,
         "export_colors": True,                      # 3.x
-        "export_vertex_color": 'ACTIVE',            # 4.2+: the active colour attribute
+        "export_vertex_color": 'MATERIAL',          # 4.2+: the attribute the material names
         "export_all_vertex_colors": False,
         "export_active_vertex_color_when_no_material": True,
     }
