@@ -23,6 +23,7 @@ ADDON_TYPES = (
     (bpy.types.Operator, "RADIOSITY_OT_solve"),
     (bpy.types.Operator, "RADIOSITY_OT_toggle_result"),
     (bpy.types.Operator, "RADIOSITY_OT_clear"),
+    (bpy.types.Operator, "RADIOSITY_OT_export_gltf"),
     (bpy.types.Panel, "RENDER_PT_radiosity"),
 )
 
