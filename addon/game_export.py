@@ -107,11 +107,12 @@ def ocio_config_path():
     env = os.environ.get("OCIO")
     if env and os.path.isfile(env):
         return env
-    path = bpy.utils.system_resource('DATAFILES', path=os.path.join("colormanagement", "config.ocio"))
-    if path and os.path.isfile(path):
-        return path
-    path = os.path.join(bpy.utils.resource_path('LOCAL'), "datafiles", "colormanagement", "config.ocio")
-    return path if os.path.isfile(path) else ""
+    for datafiles in (bpy.utils.system_resource('DATAFILES'),
+                      os.path.join(bpy.utils.resource_path('LOCAL'), "datafiles")):
+        path = os.path.join(datafiles or "", "colormanagement", "config.ocio")
+        if datafiles and os.path.isfile(path):
+            return path
+    return ""
 
 
 def import_ocio():
