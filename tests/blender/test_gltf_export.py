@@ -283,5 +283,79 @@ class ExportRefusalTest(unittest.TestCase):
         self.assertFalse(bpy.ops.radiosity.export_gltf.poll())
 
 
+class ViewTransformTest(unittest.TestCase):
+    """The game-ready colours of a non-Standard view are what Blender shows: a Cycles
+    render of emitting planes through Filmic, with exposure, a look and gamma, saved
+    as an 8-bit PNG, against display_encoded of the same radiance."""
+
+    RADIANCE = np.array([[0.05, 0.5, 3.0], [0.18, 0.18, 0.18], [8.0, 1.0, 0.01]])
+
+    def render(self, scene):
+        scene.render.engine = 'CYCLES'
+        scene.cycles.device = 'CPU'
+        scene.cycles.samples = 1
+        scene.cycles.use_denoising = False
+        scene.render.resolution_x, scene.render.resolution_y = 30, 10
+        scene.render.resolution_percentage = 100
+        scene.render.dither_intensity = 0.0
+        scene.render.image_settings.file_format = 'PNG'
+        scene.render.image_settings.color_depth = '8'
+        path = os.path.join(TMP, "view.png")
+        scene.render.filepath = path
+        with bpy.context.temp_override(scene=scene):
+            bpy.ops.render.render(write_still=True, scene=scene.name)
+        image = bpy.data.images.load(path)
+        image.colorspace_settings.name = 'Non-Color'
+        pixels = np.empty(len(image.pixels), dtype=np.float32)
+        image.pixels.foreach_get(pixels)
+        bpy.data.images.remove(image)
+        return pixels.reshape(10, 30, 4)[5, [5, 15, 25], :3]
+
+    def test_filmic_look_exposure_gamma_match_a_render(self):
+        if not game_export.import_ocio():
+            self.skipTest("no PyOpenColorIO in this Blender: game-ready colours use Standard")
+        bpy.ops.wm.read_homefile(use_empty=True)
+        scene = bpy.context.scene
+        scene.world = None
+        camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+        camera.data.type = 'ORTHO'
+        camera.data.ortho_scale = 3.0
+        camera.location = (0.0, 0.0, 5.0)
+        scene.collection.objects.link(camera)
+        scene.camera = camera
+        for i, colour in enumerate(self.RADIANCE):
+            mesh = bpy.data.meshes.new("Plane%d" % i)
+            x = i - 1.0
+            mesh.from_pydata([(x - 0.5, -1, 0), (x + 0.5, -1, 0), (x + 0.5, 1, 0), (x - 0.5, 1, 0)], [], [(0, 1, 2, 3)])
+            material = bpy.data.materials.new("Emit%d" % i)
+            material.use_nodes = True
+            nodes = material.node_tree.nodes
+            nodes.clear()
+            emission = nodes.new("ShaderNodeEmission")
+            emission.inputs["Color"].default_value = (*colour, 1.0)
+            emission.inputs["Strength"].default_value = 1.0
+            output = nodes.new("ShaderNodeOutputMaterial")
+            material.node_tree.links.new(emission.outputs[0], output.inputs["Surface"])
+            mesh.materials.append(material)
+            scene.collection.objects.link(bpy.data.objects.new("Plane%d" % i, mesh))
+        view = scene.view_settings
+        view.view_transform = 'Filmic'
+        view.exposure = 0.5
+        view.gamma = 1.2
+        for look in ("Medium High Contrast", "Filmic - Medium High Contrast"):  # 4.x, 3.x names
+            try:
+                view.look = look
+                break
+            except TypeError:
+                continue
+        self.assertIn("Medium High Contrast", view.look)
+        rendered = self.render(scene)
+        settings, note = game_export.display_settings(scene)
+        self.assertEqual(note, "")
+        expected = display_colours.display_encoded(self.RADIANCE, settings)
+        print("rendered", rendered.round(4).tolist(), "expected", expected.round(4).tolist())
+        np.testing.assert_allclose(rendered, expected, atol=2.5 / 255)
+
+
 if __name__ == "__main__":
     unittest.main()
