@@ -43,7 +43,7 @@ the selection).
 import os
 
 import bpy
-from bpy.props import BoolProperty, StringProperty
+from bpy.props import StringProperty
 from bpy.types import Operator
 from bpy_extras.io_utils import ExportHelper
 
@@ -208,9 +208,12 @@ def gltf_exporter_properties():
 
 
 def export_gltf(context, filepath):
-    """Write the result objects of the context's scene to `filepath` (.glb or .gltf).
-    Returns the objects written; raises RuntimeError with a message for the user."""
+    """Write the result objects of the context's scene to `filepath` (.glb or .gltf;
+    .glb added to another name). Returns (the objects written, the path); raises
+    RuntimeError with a message for the user."""
     scene, view_layer = context.scene, context.view_layer
+    if os.path.splitext(filepath)[1].lower() not in (".glb", ".gltf"):
+        filepath += ".glb"
     objects = [o for o in bake.result_objects(scene) if view_layer.objects.get(o.name) is not None]
     if not objects:
         raise RuntimeError("No radiosity result to export: solve with output Refined Meshes first")
@@ -248,7 +251,7 @@ def export_gltf(context, filepath):
             if view_layer.objects.get(obj.name) is not None:
                 obj.select_set(True, view_layer=view_layer)
         view_layer.objects.active = active
-    return objects
+    return objects, filepath
 
 
 class RADIOSITY_OT_export_gltf(Operator, ExportHelper):
@@ -261,7 +264,7 @@ class RADIOSITY_OT_export_gltf(Operator, ExportHelper):
 
     filename_ext = ".glb"
     filter_glob: StringProperty(default="*.glb;*.gltf", options={'HIDDEN'})
-    check_extension: BoolProperty(default=False, options={'HIDDEN'})
+    check_extension = False  # .glb by default, .gltf allowed
 
     @classmethod
     def poll(cls, context):
@@ -269,9 +272,9 @@ class RADIOSITY_OT_export_gltf(Operator, ExportHelper):
 
     def execute(self, context):
         try:
-            objects = export_gltf(context, self.filepath)
+            objects, path = export_gltf(context, self.filepath)
         except RuntimeError as err:
             self.report({'ERROR'}, str(err))
             return {'CANCELLED'}
-        self.report({'INFO'}, "Radiosity: %d objects exported to %s" % (len(objects), self.filepath))
+        self.report({'INFO'}, "Radiosity: %d objects exported to %s" % (len(objects), path))
         return {'FINISHED'}

@@ -220,6 +220,12 @@ class GltfExportTest(unittest.TestCase):
         self.assertEqual(self.selected_after, ["Cube"])
         self.assertEqual(self.active_after.name, "Cube")
 
+    def test_glb_added_to_a_name_without_extension(self):
+        path = os.path.join(TMP, "level")
+        self.assertEqual(bpy.ops.radiosity.export_gltf(filepath=path), {'FINISHED'})
+        self.assertTrue(os.path.isfile(path + ".glb"))
+        self.assertEqual(read_glb(path + ".glb")[0]["nodes"], self.gltf["nodes"])
+
     def test_validator_finds_no_error(self):
         issues = self.report["issues"]
         errors = [m for m in issues["messages"] if m["severity"] == 0]
