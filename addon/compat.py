@@ -45,6 +45,12 @@ def light_normalized(light):
     return bool(getattr(light, "normalize", True))
 
 
+def light_soft_falloff(light):
+    """Whether a point or spot light with a radius falls off softly (a disk facing
+    the receiver in Cycles): 4.x's use_soft_falloff, default on; always before."""
+    return bool(getattr(light, "use_soft_falloff", True))
+
+
 def set_cutout_transparency(material):
     """EEVEE shows the baked material's transparent back faces as cut-outs, without
     shadows: blend_method 'CLIP' and shadow_method 'NONE' before EEVEE Next (4.2),

@@ -11,9 +11,12 @@ What is exported, as a Cycles render would see it:
   Principled BSDF or an Emission shader);
 - area lights as one-sided emitting polygons (rectangle, square, disk, ellipse)
   that cast no shadow (Cycles lets light through a light object: measured)
-  with Blender's power-to-radiance conversion (geometry.area_light_radiance).
-What is not modelled (point, spot and sun lights, node setups other than the
-above) is collected in `ExportedScene.unmodelled` for one warning.
+  with Blender's power-to-radiance conversion (geometry.area_light_radiance);
+- point, spot and sun lights as the solver's direct lights, and a uniform world
+  colour (Background colour x strength) as the world's radiance, each with
+  Blender's conventions measured in Cycles (light_units.py).
+What is not modelled (node setups other than the above, textured worlds) is
+collected in `ExportedScene.unmodelled` for one warning.
 """
 
 import math
@@ -22,7 +25,7 @@ from dataclasses import dataclass, field
 import bpy
 import numpy as np
 
-from . import compat, geometry
+from . import compat, geometry, light_units
 
 # Objects the add-on itself made, which must never be solved again.
 RESULT_TAG = "radiosity_result"
@@ -53,6 +56,8 @@ class ExportedScene:
     parts: list
     unmodelled: list          # human-readable descriptions of what was not modelled
     hidden_sources: list      # names of original objects whose render visibility the bake may toggle
+    lights: list = field(default_factory=list)  # point, spot and sun lights in the solver's form
+    world: np.ndarray = None  # radiance of a uniform world, or None for black
 
     @property
     def face_count(self):
@@ -227,6 +232,7 @@ def export_scene(context, blender_version=None):
     parts = []
     lights_not_modelled = {}
     light_notes = set()
+    direct_lights = []
     hidden_sources = set()
     names_used = {}
 
@@ -242,8 +248,14 @@ def export_scene(context, blender_version=None):
         if obj.type == 'LIGHT':
             light = obj.data
             if light.type != 'AREA':
-                kind = light.type.lower()
-                lights_not_modelled[kind] = lights_not_modelled.get(kind, 0) + 1
+                solver_light = _direct_light(light, matrix, version)
+                if solver_light is None:
+                    kind = light.type.lower()
+                    lights_not_modelled[kind] = lights_not_modelled.get(kind, 0) + 1
+                elif np.any(solver_light.get("intensity", solver_light.get("irradiance")) > 0):
+                    direct_lights.append(solver_light)
+                if light.use_nodes:
+                    light_notes.add("light node setups")
                 continue
             local, area = geometry.area_light_polygon(light.shape, light.size, light.size_y)
             area = geometry.scaled_area(matrix, area)
@@ -294,8 +306,66 @@ def export_scene(context, blender_version=None):
         unmodelled.append("material%s %s (unknown node setup: viewport colour used)"
                           % ("s" if len(reader.unknown) > 1 else "", ", ".join(sorted(reader.unknown))))
     unmodelled.extend(sorted(light_notes))
+    world, world_note = world_radiance(context.scene.world)
+    if world_note:
+        unmodelled.append(world_note)
     return ExportedScene(arrays=builder.arrays(), parts=parts, unmodelled=unmodelled,
-                         hidden_sources=sorted(hidden_sources))
+                         hidden_sources=sorted(hidden_sources), lights=direct_lights, world=world)
+
+
+def _direct_light(light, matrix, version):
+    """A point, spot or sun light in the solver's form (a dict), or None if unknown.
+
+    Blender's lights shine along their local -z."""
+    position = matrix[:3, 3]
+    axis = -matrix[:3, 2]
+    norm = np.linalg.norm(axis)
+    axis = axis / norm if norm > 0 else np.array([0.0, 0.0, -1.0])
+    colour = compat.light_colour(light)
+    exposure, normalize = compat.light_exposure(light), compat.light_normalized(light)
+    # 4.x: with soft falloff (the default) a light with a radius is a disk
+    # facing the receiver, as in 3.x; without it, a sphere (light_units.py).
+    soft = compat.light_soft_falloff(light)
+    if light.type == 'POINT':
+        units = light_units.point_light(version, light.energy, colour, light.shadow_soft_size, exposure, normalize,
+                                        soft)
+        return {"type": "point", "position": position, "intensity": units["intensity"],
+                "radius": units["radius"], "shape": units["shape"].lower()}
+    if light.type == 'SPOT':
+        units = light_units.spot_light(version, light.energy, colour, light.shadow_soft_size,
+                                       light.spot_size, light.spot_blend, exposure, normalize, soft)
+        return {"type": "spot", "position": position, "intensity": units["intensity"],
+                "radius": units["radius"], "shape": units["shape"].lower(),
+                "direction": axis, "cos_half_angle": units["cos_half_angle"],
+                "blend_width": units["cos_blend_width"], "cosine_falloff": units["cos_factor"]}
+    if light.type == 'SUN':
+        units = light_units.sun_light(version, light.energy, colour, light.angle, exposure, normalize)
+        return {"type": "sun", "direction": axis, "irradiance": units["irradiance"], "angle": units["angle"]}
+    return None
+
+
+def world_radiance(world):
+    """(radiance rgb or None, note) of a world: Background colour x strength when it is
+    uniform (no texture feeding it), else None and a note for the warning."""
+    if world is None:
+        return None, ""
+    if not world.use_nodes or world.node_tree is None:
+        colour = np.array(world.color[:3], dtype=float)
+        return (colour if np.any(colour > 0) else None), ""
+    output = next((n for n in world.node_tree.nodes if n.type == 'OUTPUT_WORLD' and n.is_active_output), None)
+    if output is None:
+        output = next((n for n in world.node_tree.nodes if n.type == 'OUTPUT_WORLD'), None)
+    if output is None or not output.inputs["Surface"].is_linked:
+        return None, ""
+    node = _linked_node(output.inputs["Surface"])
+    if node is None:
+        return None, ""
+    if node.type == 'BACKGROUND' and not node.inputs["Color"].is_linked:
+        strength = _scalar(node.inputs["Strength"], 1.0)
+        if strength is not None:
+            colour = np.array(node.inputs["Color"].default_value[:3], dtype=float) * strength
+            return light_units.world_radiance(colour, 1.0) if np.any(colour > 0) else None, ""
+    return None, "world %s (only a uniform Background colour is modelled)" % world.name
 
 
 def _unique(used, name):

@@ -222,14 +222,15 @@ class RADIOSITY_OT_solve(Operator):
         if exported.face_count == 0:
             raise SolveError("Nothing to solve: the scene has no visible mesh objects or area lights"
                              + (" (%s)" % note if note else ""))
-        if not np.any(arrays["emission"] > 0):
-            raise SolveError("No light to solve: add an emissive material (Emission shader or "
-                             "Principled Emission) or an area light"
+        if not np.any(arrays["emission"] > 0) and not exported.lights and exported.world is None:
+            raise SolveError("No light to solve: add a light, an emissive material (Emission shader or "
+                             "Principled Emission) or a world colour"
                              + (" (%s)" % note if note else ""))
         try:
             native_scene = solver.Scene(arrays["positions"], arrays["face_vertices"], arrays["face_sizes"],
                                         arrays["reflectance"], arrays["emission"], arrays["two_sided"],
-                                        occludes=arrays["occludes"])
+                                        occludes=arrays["occludes"], lights=exported.lights,
+                                        world=exported.world)
         except ValueError as err:
             raise SolveError("Radiosity: %s" % err) from None
         settings = scene.radiosity

@@ -29,3 +29,11 @@ CONTACT_SCENES = {
     "lamp_on_table": "3 x 3 x 2.5 m room lit only by an emissive plane lying on a table top",
     "picture_on_wall": "3 x 3 x 2.5 m room with a recessed ceiling light, a picture 1 mm in front of a wall",
 }
+
+# Scenes lit the ways Blender users light them (issue 15): point, spot and sun
+# lights and the world's colour; tests/blender/test_lights.py checks them
+# against Cycles.
+LIGHT_SCENES = {
+    "lights_room": "4 x 3 x 2.6 m room with a window: a point light, a soft-edged spot, the sun and the "
+                   "world through the window (build(scene, lights=...) takes a subset)",
+}

@@ -77,6 +77,7 @@ struct PushPull {
   Hierarchy& h;
   const LinkGather& gather;
   const std::vector<SampleScale>& down_scale;
+  const std::vector<SampleRgb>& direct;
   std::vector<SampleRgb>* leaf_out;
 
   Rgb operator()(std::int32_t index, const SampleRgb& down, Change& change) const;
@@ -88,6 +89,8 @@ Rgb PushPull::operator()(std::int32_t index, const SampleRgb& down, Change& chan
   const bool scaled = e.is_leaf() && static_cast<size_t>(index) < down_scale.size();
   for (size_t s = 0; s < kMaxSamples; ++s)
     total[s] += scaled ? static_cast<double>(down_scale[static_cast<size_t>(index)][s]) * down[s] : down[s];
+  if (static_cast<size_t>(index) < direct.size())
+    for (size_t s = 0; s < kMaxSamples; ++s) total[s] += direct[static_cast<size_t>(index)][s];
   Rgb radiance;
   if (e.is_leaf()) {
     radiance = h.emission(e) + h.reflectance(e) * glm::max(Interpolant::average(e.corner_count, total), Rgb(0.0));
@@ -120,9 +123,10 @@ std::vector<SampleRgb> gathered_at_leaves(const Hierarchy& h, const LinkGather& 
 }
 
 double push_pull(Hierarchy& h, const LinkGather& gather, const std::vector<Rgb>& far_light,
-                 const std::vector<SampleScale>& down_scale, std::vector<SampleRgb>* leaf_out) {
+                 const std::vector<SampleScale>& down_scale, const std::vector<SampleRgb>& direct,
+                 std::vector<SampleRgb>* leaf_out) {
   std::vector<Change> changes(h.root_count());
-  const PushPull visit{h, gather, down_scale, leaf_out};
+  const PushPull visit{h, gather, down_scale, direct, leaf_out};
   for_each_root(h, [&](size_t r, std::int32_t root) { visit(root, far_down(far_light, root), changes[r]); });
   Change sum;
   for (const Change& c : changes) sum.delta += c.delta, sum.total += c.total;

@@ -47,9 +47,12 @@ std::vector<SampleRgb> gathered_at_leaves(const Hierarchy& hierarchy, const Link
 // area average of its children's. Returns the relative change of radiance,
 // area-weighted over leaves. `down_scale` (per element, may be empty) scales
 // what each leaf sample receives from its ancestors (energy_balance.h).
+// `direct` (per element, may be empty) is what each element gathers from the
+// lights that are not surfaces (direct_light.h), at its samples.
 // `leaf_out`, if given, receives what each leaf gathered at its samples (for
 // the output mesh).
 double push_pull(Hierarchy& hierarchy, const LinkGather& gather, const std::vector<Rgb>& far_light,
-                 const std::vector<SampleScale>& down_scale, std::vector<SampleRgb>* leaf_out = nullptr);
+                 const std::vector<SampleScale>& down_scale, const std::vector<SampleRgb>& direct,
+                 std::vector<SampleRgb>* leaf_out = nullptr);
 
 }  // namespace radiosity

@@ -173,9 +173,12 @@ OutputMesh make_output_mesh(const Hierarchy& h,
   };
 
   // Radiance at pool vertices: the mean over the leaves that have it as a corner.
-  std::vector<glm::dvec3> sum(h.vertex_count(), glm::dvec3(0.0));
-  std::vector<glm::dvec3> sum_h(h.vertex_count(), glm::dvec3(0.0));  // the same before rho and L_e
-  std::vector<std::uint32_t> count(h.vertex_count(), 0);
+  // Per vertex: radiance and gathered H (before rho and L_e) summed, and how many leaves.
+  struct VertexSum {
+    glm::dvec3 radiance{0.0}, gathered{0.0};
+    std::uint32_t count = 0;
+  };
+  std::vector<VertexSum> sums(h.vertex_count());
   for (size_t i = 0; i < elements.size(); ++i) {
     const Element& e = elements[i];
     if (!e.is_leaf() || !shown(e.patch, e.side)) continue;
@@ -184,9 +187,10 @@ OutputMesh make_output_mesh(const Hierarchy& h,
       // Energy-conserving link corrections (link_transport.cpp) may leave a
       // sample a rounding below zero; light is never negative.
       const Rgb gathered = glm::max(leaf_irradiance[i][static_cast<size_t>(k)], Rgb(0.0));
-      sum[e.corner[static_cast<size_t>(k)]] += glm::dvec3(emission + rho * gathered);
-      sum_h[e.corner[static_cast<size_t>(k)]] += glm::dvec3(gathered);
-      ++count[e.corner[static_cast<size_t>(k)]];
+      VertexSum& sum = sums[e.corner[static_cast<size_t>(k)]];
+      sum.radiance += glm::dvec3(emission + rho * gathered);
+      sum.gathered += glm::dvec3(gathered);
+      ++sum.count;
     }
   }
 
@@ -194,8 +198,11 @@ OutputMesh make_output_mesh(const Hierarchy& h,
   const auto append = [](std::vector<float>& out, const glm::dvec3& value) {
     out.insert(out.end(), {static_cast<float>(value.x), static_cast<float>(value.y), static_cast<float>(value.z)});
   };
-  const auto mean_of = [&](const std::vector<glm::dvec3>& sums, std::uint32_t v) {
-    return count[v] ? sums[v] / static_cast<double>(count[v]) : glm::dvec3(0.0);
+  const auto radiance_at = [&](std::uint32_t v) {
+    return sums[v].count ? sums[v].radiance / static_cast<double>(sums[v].count) : glm::dvec3(0.0);
+  };
+  const auto gathered_at = [&](std::uint32_t v) {
+    return sums[v].count ? sums[v].gathered / static_cast<double>(sums[v].count) : glm::dvec3(0.0);
   };
   std::vector<std::int32_t> remap(h.vertex_count(), kNone);
   const auto output_vertex = [&](std::uint32_t v) {
@@ -203,8 +210,8 @@ OutputMesh make_output_mesh(const Hierarchy& h,
       remap[v] = static_cast<std::int32_t>(mesh.positions.size() / 3);
       const dvec3& p = h.vertex(v);
       mesh.positions.insert(mesh.positions.end(), {p.x, p.y, p.z});
-      append(mesh.radiance, mean_of(sum, v));
-      append(mesh.vertex_irradiance, mean_of(sum_h, v));
+      append(mesh.radiance, radiance_at(v));
+      append(mesh.vertex_irradiance, gathered_at(v));
     }
     return remap[v];
   };
@@ -221,8 +228,8 @@ OutputMesh make_output_mesh(const Hierarchy& h,
     const double t = std::clamp(glm::dot(p - pa, ab) / glm::dot(ab, ab), 0.0, 1.0);
     const auto index = static_cast<std::int32_t>(mesh.positions.size() / 3);
     mesh.positions.insert(mesh.positions.end(), {p.x, p.y, p.z});
-    append(mesh.radiance, (1 - t) * mean_of(sum, a) + t * mean_of(sum, b));
-    append(mesh.vertex_irradiance, (1 - t) * mean_of(sum_h, a) + t * mean_of(sum_h, b));
+    append(mesh.radiance, (1 - t) * radiance_at(a) + t * radiance_at(b));
+    append(mesh.vertex_irradiance, (1 - t) * gathered_at(a) + t * gathered_at(b));
     return index;
   };
   std::vector<std::uint32_t> edge, between;

@@ -253,8 +253,20 @@ Scene make_scene(const SceneArrays& a) {
     for (const PatchSide& side : p.sides)
       if (side.present) scene.emitted_power += luminance(side.emission) * p.area;
   }
-  if (!(scene.emitted_power > 0.0)) {
-    fail("the scene has no emitter: at least one face needs an emission above 0");
+  for (size_t i = 0; i < a.lights.size(); ++i) check_light(a.lights[i], i);
+  for (const Light& light : a.lights)
+    if (luminance(light.colour) > 0.0) scene.lights.push_back(light);
+  for (int c = 0; c < 3; ++c) {
+    if (!(std::isfinite(a.world[c]) && a.world[c] >= 0.0)) fail("the world's radiance must be finite and >= 0");
+  }
+  if (luminance(a.world) > 0.0) {
+    Light sky;
+    sky.kind = LightKind::Sky;
+    sky.colour = a.world;
+    scene.lights.push_back(sky);
+  }
+  if (!(scene.emitted_power > 0.0) && scene.lights.empty()) {
+    fail("the scene has no light: no face emits, and there is no light and no world colour");
   }
   return scene;
 }

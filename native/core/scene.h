@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/color.h"
+#include "core/lights.h"
 #include "core/vec.h"
 
 namespace radiosity {
@@ -26,6 +27,11 @@ struct SceneArrays {
   // Per face, or empty: every face casts shadows. Blender's lights do not
   // (Cycles lets light through them, measured): their polygons only emit.
   std::span<const std::uint8_t> occludes;
+  // Point, spot and sun lights (lights.h), checked by make_scene.
+  std::span<const Light> lights;
+  // Radiance of a uniform world (Background colour x strength): light from
+  // every direction a side sees past the scene's geometry.
+  Rgb world{0.0};
 };
 
 // One side of a patch: the input face it shows and that face's material.
@@ -76,6 +82,9 @@ struct Scene {
   // those merged into a coinciding face.
   std::vector<Patch> occluders;
   std::vector<SkippedFace> skipped;
+  // Direct light that is not a surface: the scene's lights, then the sky when
+  // the world is not black (lights.h, direct_light.h).
+  std::vector<Light> lights;
   // Pairs of input faces that coincide somewhere (the same surface twice, as
   // z-fighting shows it); each is counted once (contact.h).
   std::vector<std::array<std::uint32_t, 2>> coincident;

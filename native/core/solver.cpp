@@ -15,6 +15,7 @@
 #include "core/cluster_tree.h"
 #include "core/gather.h"
 #include "core/convergence.h"
+#include "core/direct_light.h"
 #include "core/energy_balance.h"
 
 namespace radiosity {
@@ -68,6 +69,8 @@ class Solver {
         occluders_(make_scene_occluders(scene)),
         evaluator_{hierarchy_, occluders_, options.visibility, options.rays, options.oracle,
                    oracle_geometric_scale(options.oracle, scene.total_area)},
+        direct_(hierarchy_, occluders_, options.visibility, options.rays, options.oracle,
+                oracle_geometric_scale(options.oracle, scene.total_area)),
         min_area_(options.min_element_area * scene.total_area),
         clusters_(hierarchy_) {}
 
@@ -83,8 +86,12 @@ class Solver {
 
   void report(const std::string& phase, double fraction);
   void link_initially();
+  void drop_links_light_cannot_reach();
   std::vector<Link> evaluate_links(std::vector<Link>&& candidates);
+  std::vector<LightLink> evaluate_light_links(std::vector<LightLink>&& candidates);
   bool refine(double threshold);
+  bool refine_light_links(double threshold);
+  void gather_direct_light();
   double adaptation_radiance() const;
   Split choose_split(const Link& link, double threshold) const;
   bool can_split(std::int32_t e) const { return hierarchy_.element(e).area / 4.0 >= min_area_; }
@@ -105,6 +112,7 @@ class Solver {
   Hierarchy hierarchy_;
   SceneOccluders occluders_;
   LinkEvaluator evaluator_;
+  DirectLight direct_;
   // Brightness the oracles' thresholds are relative to (refine()).
   double reference_radiance_ = 0.0;
   const double min_area_;
@@ -117,6 +125,11 @@ class Solver {
   std::vector<ClusterLink> cluster_links_;
   ClusterGather cluster_gather_;
   std::vector<Rgb> far_light_;  // what each top-level element gathers through cluster links
+  // Light from the lights that are not surfaces: one link per leaf and light
+  // that reaches it, and what each element gathers from them at its samples.
+  std::vector<LightLink> light_links_;
+  std::vector<SampleRgb> direct_light_;
+  std::uint64_t light_version_ = 1, direct_version_ = 0;
   std::uint64_t links_version_ = 1, grouped_version_ = 0;
   SolveResult result_;  // the last complete pass
   bool budget_hit_ = false;
@@ -145,9 +158,9 @@ void Solver::track_memory() {
   stats_.element_bytes = hierarchy_.memory_bytes() + offset_.capacity() * sizeof(std::uint32_t) +
                          source_.capacity() * sizeof(Rgb) + clusters_.memory_bytes() +
                          cluster_gather_.memory_bytes() + far_light_.capacity() * sizeof(Rgb) +
-                         balance_.memory_bytes();
+                         balance_.memory_bytes() + direct_light_.capacity() * sizeof(SampleRgb);
   stats_.link_bytes = links_.capacity() * sizeof(Link) + order_.capacity() * sizeof(std::uint32_t) +
-                      cluster_links_.capacity() * sizeof(ClusterLink);
+                      cluster_links_.capacity() * sizeof(ClusterLink) + light_links_.capacity() * sizeof(LightLink);
   stats_.peak_bytes = std::max(stats_.peak_bytes, stats_.element_bytes + stats_.link_bytes);
 }
 
@@ -219,6 +232,20 @@ std::vector<Link> Solver::evaluate_links(std::vector<Link>&& candidates) {
   return std::move(candidates);
 }
 
+// Evaluates light links in parallel and keeps those that deliver light, in
+// their original order (deterministic for any thread count).
+std::vector<LightLink> Solver::evaluate_light_links(std::vector<LightLink>&& candidates) {
+  std::vector<std::uint8_t> lit(candidates.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, candidates.size()), [&](const auto& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) lit[i] = direct_.evaluate(candidates[i]) ? 1 : 0;
+  });
+  size_t kept = 0;
+  for (size_t i = 0; i < candidates.size(); ++i)
+    if (lit[i]) candidates[kept++] = candidates[i];
+  candidates.resize(kept);
+  return std::move(candidates);
+}
+
 // Links between the top-level patch sides that can exchange light (the
 // receiver reflects, the emitter emits or reflects): clusters far apart that
 // face each other get one cluster link, pairs facing away are dropped whole,
@@ -243,19 +270,57 @@ void Solver::link_initially() {
   }
   candidates = {};
   cluster_links_ = std::move(initial.clusters);
+  cluster_links_.shrink_to_fit();
+  if (!scene_.lights.empty() && !cancelled()) {
+    light_links_ = evaluate_light_links(direct_.initial_links());
+    ++light_version_;
+  }
+  drop_links_light_cannot_reach();
   for (const ClusterLink& l : cluster_links_) {
     const ClusterNode& node = clusters_.node(l.receiver);
     for (std::uint32_t i = node.first; i < node.first + node.count; ++i)
       hierarchy_.element(clusters_.sides()[i]).has_links = 1;
   }
-  cluster_links_.shrink_to_fit();
   if (cluster_links_.empty()) clusters_.release();
   for (const Link& l : links_) hierarchy_.element(l.receiver).has_links = 1;
+  for (const LightLink& l : light_links_) hierarchy_.element(l.receiver).has_links = 1;
   links_.shrink_to_fit();
   hierarchy_.shrink_to_fit();
   ++links_version_;
   stats_.seconds_linking = std::chrono::duration<double>(Clock::now() - start).count();
   track_memory();
+}
+
+// A side that no light can reach (the inside of a closed box, the floor
+// under it) keeps no links: it would never carry any light, yet its links
+// would be gathered, its elements shown (doubling the box in the output) and
+// its leaks of rounding taken for light. Light starts at the emitting sides
+// and the receivers of light links and spreads through the links, from
+// emitter to receiver; cluster links count as reaching every side of their
+// receiving cluster.
+void Solver::drop_links_light_cannot_reach() {
+  const size_t sides = hierarchy_.root_count();
+  std::vector<std::uint8_t> reached(hierarchy_.elements().size(), 0);
+  for (size_t r = 0; r < sides; ++r) {
+    const std::int32_t root = hierarchy_.root(static_cast<std::uint32_t>(r / 2), static_cast<int>(r % 2));
+    if (root != kNone && luminance(hierarchy_.emission(hierarchy_.element(root))) > 0.0) reached[static_cast<size_t>(root)] = 1;
+  }
+  for (const LightLink& l : light_links_) reached[static_cast<size_t>(l.receiver)] = 1;
+  for (const ClusterLink& l : cluster_links_) {
+    const ClusterNode& node = clusters_.node(l.receiver);
+    for (std::uint32_t i = node.first; i < node.first + node.count; ++i)
+      reached[static_cast<size_t>(clusters_.sides()[i])] = 1;
+  }
+  for (bool spread = true; spread;) {
+    spread = false;
+    for (const Link& l : links_) {
+      if (reached[static_cast<size_t>(l.emitter)] && !reached[static_cast<size_t>(l.receiver)]) {
+        reached[static_cast<size_t>(l.receiver)] = 1;
+        spread = true;
+      }
+    }
+  }
+  std::erase_if(links_, [&](const Link& l) { return !reached[static_cast<size_t>(l.receiver)]; });
 }
 
 // Is one end of the link closer to the other than twice its own radius? Then
@@ -375,7 +440,14 @@ bool Solver::refine(double threshold) {
       kept = std::move(staying);
       fresh = std::move(fresh_leaves);
     }
-    if (fresh.empty()) break;
+    const bool lights_changed = refine_light_links(threshold);
+    if (fresh.empty()) {
+      if (lights_changed) {
+        changed = true;
+        continue;
+      }
+      break;
+    }
     changed = true;
     std::vector<Link> made = evaluate_links(std::move(fresh));
     if (cancelled()) break;  // a partial evaluation is discarded with the pass
@@ -394,6 +466,66 @@ bool Solver::refine(double threshold) {
     track_memory();
   }
   return changed;
+}
+
+// Light links take part in refinement like links whose emitter cannot be
+// split: one above the threshold splits its receiver. Then every light link
+// whose receiver was split (by it or by any link) is replaced by its
+// children's, so direct light is always evaluated at the leaves that gather
+// it. Returns whether the light links changed.
+bool Solver::refine_light_links(double threshold) {
+  if (light_links_.empty()) return false;
+  const auto& lights = scene_.lights;
+  std::vector<std::uint8_t> split(light_links_.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, light_links_.size()), [&](const auto& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      const LightLink& l = light_links_[i];
+      const Element& p = hierarchy_.element(l.receiver);
+      const double brightness = luminance(hierarchy_.reflectance(p) * lights[l.light].colour);
+      split[i] = p.is_leaf() && brightness / reference_radiance_ * l.oracle > threshold && can_split(l.receiver);
+    }
+  });
+  for (size_t i = 0; i < light_links_.size(); ++i) {
+    if (!split[i] || !hierarchy_.element(light_links_[i].receiver).is_leaf()) continue;
+    if (options_.max_elements && hierarchy_.elements().size() + 4 > *options_.max_elements) {
+      budget_hit_ = true;
+      break;
+    }
+    hierarchy_.subdivide(light_links_[i].receiver);
+  }
+  std::vector<LightLink> kept, fresh;
+  for (const LightLink& l : light_links_) {
+    const Element& p = hierarchy_.element(l.receiver);
+    if (p.is_leaf()) {
+      kept.push_back(l);
+      continue;
+    }
+    for (std::int32_t c = p.first_child; c < p.first_child + 4; ++c) {
+      LightLink child;
+      child.receiver = c;
+      child.light = l.light;
+      fresh.push_back(child);
+    }
+  }
+  if (fresh.empty()) return false;
+  std::vector<LightLink> made = evaluate_light_links(std::move(fresh));
+  for (const LightLink& l : made) hierarchy_.element(l.receiver).has_links = 1;
+  kept.insert(kept.end(), made.begin(), made.end());
+  light_links_ = std::move(kept);
+  ++light_version_;
+  return true;
+}
+
+// What each element gathers from the light links, rebuilt when they change.
+void Solver::gather_direct_light() {
+  if (light_links_.empty() || direct_version_ == light_version_) return;
+  direct_light_.assign(hierarchy_.elements().size(), SampleRgb{});
+  for (const LightLink& l : light_links_) {
+    const Rgb colour = scene_.lights[l.light].colour;
+    SampleRgb& out = direct_light_[static_cast<size_t>(l.receiver)];
+    for (size_t s = 0; s < kMaxSamples; ++s) out[s] += static_cast<double>(l.value[s]) * colour;
+  }
+  direct_version_ = light_version_;
 }
 
 // Groups the links by receiver (counting sort keeps link order within a
@@ -435,7 +567,9 @@ double Solver::gather_push_pull() {
   group_links();
   balance_.sent_radiances(hierarchy_, source_);
   gather_far_light();
-  return push_pull(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_, balance_.down_scale());
+  gather_direct_light();
+  return push_pull(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_, balance_.down_scale(),
+                   direct_light_);
 }
 
 
@@ -479,7 +613,9 @@ void Solver::snapshot(double threshold) {
   source_.resize(hierarchy_.elements().size(), Rgb(0.0));
   group_links();
   gather_far_light();
-  push_pull(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_, balance_.down_scale(), &leaf);
+  gather_direct_light();
+  push_pull(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_, balance_.down_scale(),
+            direct_light_, &leaf);
   result_.mesh = make_output_mesh(hierarchy_, leaf);
   stats_.threshold = threshold;
 }
@@ -539,6 +675,7 @@ SolveResult Solver::run() {
                                                     [](const Element& e) { return e.is_leaf(); }));
   stats_.links = links_.size();
   stats_.cluster_links = cluster_links_.size();
+  stats_.light_links = light_links_.size();
   stats_.skipped_faces = scene_.skipped.size();
   track_memory();
   stats_.seconds = elapsed();

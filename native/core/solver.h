@@ -67,6 +67,7 @@ struct SolveStats {
   std::size_t leaves = 0;
   std::size_t links = 0;
   std::size_t cluster_links = 0;
+  std::size_t light_links = 0;  // leaf and light pairs of direct light (direct_light.h)
   int passes = 0;
   int iterations = 0;
   double residual = 0.0;     // relative change of the last iteration

@@ -8,6 +8,7 @@
 #include <pybind11/stl.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <atomic>
 #include <exception>
 #include <memory>
@@ -45,9 +46,76 @@ InputArray<std::int64_t> read_indices(const py::handle& object, const std::strin
   return read_array_of<std::int64_t>(object, name, {-1});
 }
 
+dvec3 read_vector(const py::dict& light, const char* key, const std::string& which) {
+  const auto v = read_array_of<double>(light[key], which + key, {3});
+  return {v.data()[0], v.data()[1], v.data()[2]};
+}
+
+double read_number(const py::dict& light, const char* key, const std::string& which) {
+  try {
+    return light[key].cast<double>();
+  } catch (const py::cast_error&) {
+    throw std::invalid_argument(which + key + " must be a number");
+  }
+}
+
+// One light from a dict: type 'point' | 'spot' | 'sun' and its parameters
+// (lights.h); unknown keys are refused, so a misspelt one is not ignored.
+Light read_light(const py::handle& item, size_t index) {
+  const std::string which = "lights[" + std::to_string(index) + "].";
+  if (!py::isinstance<py::dict>(item)) throw std::invalid_argument("lights[" + std::to_string(index) + "] must be a dict");
+  const auto light = py::reinterpret_borrow<py::dict>(item);
+  if (!light.contains("type")) throw std::invalid_argument(which + "type is missing ('point', 'spot' or 'sun')");
+  const auto kind = parse_light_kind(py::str(light["type"]).cast<std::string>());
+  if (!kind) throw std::invalid_argument(which + "type must be 'point', 'spot' or 'sun'");
+  Light out;
+  out.kind = *kind;
+  std::vector<std::string> allowed = {"type"};
+  const auto take = [&](const char* key, bool required) {
+    allowed.emplace_back(key);
+    if (light.contains(key)) return true;
+    if (required) throw std::invalid_argument(which + key + " is missing");
+    return false;
+  };
+  if (out.kind == LightKind::Sun) {
+    take("irradiance", true);
+    const dvec3 e = read_vector(light, "irradiance", which);
+    out.colour = Rgb(e);
+    take("direction", true);
+    out.direction = read_vector(light, "direction", which);
+    if (take("angle", false)) out.angle = read_number(light, "angle", which);
+  } else {
+    take("intensity", true);
+    out.colour = Rgb(read_vector(light, "intensity", which));
+    take("position", true);
+    out.position = read_vector(light, "position", which);
+    if (take("radius", false)) out.radius = read_number(light, "radius", which);
+    if (take("shape", false)) {
+      const std::string shape = py::str(light["shape"]).cast<std::string>();
+      if (shape != "sphere" && shape != "disk") throw std::invalid_argument(which + "shape must be 'sphere' or 'disk'");
+      out.sphere = shape == "sphere";
+    }
+    if (out.kind == LightKind::Spot) {
+      take("direction", true);
+      out.direction = read_vector(light, "direction", which);
+      take("cos_half_angle", true);
+      out.cos_half_angle = read_number(light, "cos_half_angle", which);
+      if (take("blend_width", false)) out.blend_width = read_number(light, "blend_width", which);
+      if (take("cosine_falloff", false)) out.cosine_falloff = light["cosine_falloff"].cast<bool>();
+    }
+  }
+  for (const auto& [key, value] : light) {
+    const std::string name = py::str(key).cast<std::string>();
+    if (std::find(allowed.begin(), allowed.end(), name) == allowed.end())
+      throw std::invalid_argument(which + name + " is not a setting of a " + py::str(light["type"]).cast<std::string>() + " light");
+  }
+  return out;
+}
+
 Scene make_python_scene(const py::handle& positions, const py::handle& face_vertices,
                         const py::handle& face_sizes, const py::handle& reflectance,
-                        const py::handle& emission, const py::handle& two_sided, const py::handle& occludes) {
+                        const py::handle& emission, const py::handle& two_sided, const py::handle& occludes,
+                        const py::handle& lights, const py::handle& world) {
   const auto p = read_array_of<double>(positions, "positions", {-1, 3});
   const auto fv = read_indices(face_vertices, "face_vertices");
   const auto fs = read_indices(face_sizes, "face_sizes");
@@ -66,6 +134,18 @@ Scene make_python_scene(const py::handle& positions, const py::handle& face_vert
   arrays.emission = {le.data(), static_cast<size_t>(le.size())};
   if (sided) arrays.two_sided = {sided.data(), static_cast<size_t>(sided.size())};
   if (shadows) arrays.occludes = {shadows.data(), static_cast<size_t>(shadows.size())};
+  std::vector<Light> light_list;
+  if (!lights.is_none()) {
+    if (!py::isinstance<py::sequence>(lights) || py::isinstance<py::str>(lights))
+      throw std::invalid_argument("lights must be a list of dicts");
+    size_t index = 0;
+    for (const py::handle item : lights) light_list.push_back(read_light(item, index++));
+  }
+  arrays.lights = light_list;
+  if (!world.is_none()) {
+    const auto w = read_array_of<double>(world, "world", {3});
+    arrays.world = Rgb(w.data()[0], w.data()[1], w.data()[2]);
+  }
   return make_scene(arrays);
 }
 
@@ -92,6 +172,7 @@ py::dict stats_dict(const SolveStats& s) {
   d["leaves"] = s.leaves;
   d["links"] = s.links;
   d["cluster_links"] = s.cluster_links;
+  d["light_links"] = s.light_links;
   d["passes"] = s.passes;
   d["iterations"] = s.iterations;
   d["residual"] = s.residual;
@@ -241,19 +322,28 @@ void bind_solver(py::module_& m) {
       .def_property_readonly("cancelled", [](const CancelToken& t) { return t.flag.load(); });
 
   py::class_<Scene>(m, "Scene",
-                    "Scene(positions, face_vertices, face_sizes, reflectance, emission, two_sided=None, occludes=None)\n\n"
+                    "Scene(positions, face_vertices, face_sizes, reflectance, emission, two_sided=None, occludes=None,\n"
+                    "      lights=None, world=None)\n\n"
                     "positions (V, 3) float; face_vertices: all faces' vertex indices concatenated;\n"
                     "face_sizes (F,) vertices per face (3 or more; larger polygons are triangulated);\n"
                     "reflectance (F, 3) in [0, 1]; emission (F, 3) radiance >= 0; two_sided (F,) bool,\n"
                     "default all True (a one-sided face has only its front: area lights); occludes (F,) bool,\n"
                     "default all True (False: the face emits but casts no shadow, as Blender's lights).\n"
+                    "lights: list of dicts, each {'type': 'point', 'position', 'intensity' (H = I cos / d^2),\n"
+                    "'radius', 'shape': 'sphere' | 'disk'}, {'type': 'spot', the same and 'direction' (its axis),\n"
+                    "'cos_half_angle', 'blend_width', 'cosine_falloff'} or {'type': 'sun', 'direction' (the way\n"
+                    "its light travels), 'irradiance' (H facing it), 'angle' (radians)}; world (3,): the radiance of\n"
+                    "a uniform world, light from every direction that leaves the scene.\n"
                     "Degenerate faces are skipped and listed in skipped_faces; bad input raises ValueError.")
       .def(py::init(&make_python_scene), py::arg("positions"), py::arg("face_vertices"),
            py::arg("face_sizes"), py::arg("reflectance"), py::arg("emission"),
-           py::arg("two_sided") = py::none(), py::arg("occludes") = py::none())
+           py::arg("two_sided") = py::none(), py::arg("occludes") = py::none(), py::arg("lights") = py::none(),
+           py::arg("world") = py::none())
       .def_property_readonly("face_count", [](const Scene& s) { return s.face_count; })
       .def_property_readonly("patch_count", [](const Scene& s) { return s.patches.size(); })
       .def_property_readonly("total_area", [](const Scene& s) { return s.total_area; })
+      .def_property_readonly("light_count", [](const Scene& s) { return s.lights.size(); },
+                             "lights solved as direct light: point, spot and sun lights, and the sky")
       .def_property_readonly("skipped_faces", [](const Scene& s) {
         py::list out;
         for (const auto& k : s.skipped) out.append(py::make_tuple(k.face, k.reason));

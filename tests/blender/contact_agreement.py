@@ -55,6 +55,12 @@ CASES = {
     "box_on_floor": ("box_on_floor", {}),
     "lamp_on_table": ("lamp_on_table", {}),
     "picture_on_wall": ("picture_on_wall", {}),
+    # Issue 15: each kind of light alone, then all together (tests/blender/test_lights.py).
+    "lights_point": ("lights_room", {"lights": ["point"]}),
+    "lights_spot": ("lights_room", {"lights": ["spot"]}),
+    "lights_sun": ("lights_room", {"lights": ["sun"]}),
+    "lights_world": ("lights_room", {"lights": ["world"]}),
+    "lights_all": ("lights_room", {}),
 }
 GAPS = (("0.1 mm", "cornell_box"), ("1 mm", "cornell_box_1mm"), ("1 cm", "cornell_box_1cm"),
         ("5 cm", "cornell_box_5cm"))
@@ -143,3 +149,42 @@ def save_pngs(folder, label, reference, solutions):
     rc.save_png(np.where(mask, [1.0, 0.0, 1.0], reference.image), os.path.join(folder, label + "_mask.png"))
     for tag, image in solutions.items():
         rc.save_png(image, os.path.join(folder, "%s_%s.png" % (label, tag)))
+
+
+MEAN_TOLERANCE = 0.03
+BLOCK_TOLERANCE = 0.06
+# The reference must resolve the tolerances: its noise alone a fraction of them.
+NOISE_FRACTION = 0.25
+
+
+def assert_agreement(test, label, qualities=QUALITIES):
+    """Asserts (on `test`, a TestCase) that every oracle at `qualities` agrees with the path
+    trace of the case `label` within the tolerances, printing the numbers."""
+    scene = build_case(label)
+    reference = Reference(label, scene)
+    noise = reference.noise()
+    print("[agreement] %s reference: %d seeds x %d samples%s; its noise: exposure %.2f %%, median block %.2f %%; "
+          "emitter pixels left out: %.1f %%"
+          % (label, len(reference.seeds), REFERENCE_SAMPLES, " (cached)" if not reference.rendered else "",
+             100 * noise["exposure"], 100 * noise["block"], 100 * reference.mask.mean()), flush=True)
+    test.assertLess(noise["exposure"], NOISE_FRACTION * MEAN_TOLERANCE)
+    test.assertLess(noise["block"], NOISE_FRACTION * BLOCK_TOLERANCE)
+    renders = {}
+    for oracle in ORACLES:
+        for quality in qualities:
+            image, stats = solve_and_render(scene, oracle, quality)
+            renders["%s_%.1f" % (oracle.lower(), quality)] = image
+            e = image_agreement.compare(image, reference.image, reference.mask)
+            print("[agreement] %s %-10s q=%.1f: exposure %+6.1f %%, median block error %5.1f %% "
+                  "(%d blocks; %d elements, %s)" % (label, oracle.lower(), quality, 100 * e["exposure"],
+                                                    100 * e["block"], e["blocks"], stats.elements, stats.status),
+                  flush=True)
+            numbers = "%s %s q=%.1f: exposure %+.1f %% (tolerance %.0f %%), median block error %.1f %% " \
+                      "(tolerance %.0f %%)" % (label, oracle.lower(), quality, 100 * e["exposure"],
+                                               100 * MEAN_TOLERANCE, 100 * e["block"], 100 * BLOCK_TOLERANCE)
+            with test.subTest(oracle=oracle, quality=quality):
+                test.assertLess(abs(e["exposure"]), MEAN_TOLERANCE, numbers)
+                test.assertLess(e["block"], BLOCK_TOLERANCE, numbers)
+    folder = os.environ.get("RADIOSITY_TEST_IMAGES")
+    if folder:
+        save_pngs(folder, label, reference, renders)

@@ -24,48 +24,14 @@ and the median block error. Renders (reference, emitter mask in magenta, every
 solution) are written to $RADIOSITY_TEST_IMAGES if set.
 """
 
-import os
 import unittest
 
 import contact_agreement as ca
-import image_agreement
-
-MEAN_TOLERANCE = 0.03
-BLOCK_TOLERANCE = 0.06
-# The reference must resolve the tolerances: its noise alone a fraction of them.
-NOISE_FRACTION = 0.25
 
 
 class ContactAgreementTest(unittest.TestCase):
     def agree(self, label):
-        scene = ca.build_case(label)
-        reference = ca.Reference(label, scene)
-        noise = reference.noise()
-        print("[agreement] %s reference: %d seeds x %d samples%s; its noise: exposure %.2f %%, median block %.2f %%; "
-              "emitter pixels left out: %.1f %%"
-              % (label, len(reference.seeds), ca.REFERENCE_SAMPLES, " (cached)" if not reference.rendered else "",
-                 100 * noise["exposure"], 100 * noise["block"], 100 * reference.mask.mean()), flush=True)
-        self.assertLess(noise["exposure"], NOISE_FRACTION * MEAN_TOLERANCE)
-        self.assertLess(noise["block"], NOISE_FRACTION * BLOCK_TOLERANCE)
-        renders = {}
-        for oracle in ca.ORACLES:
-            for quality in ca.QUALITIES:
-                image, stats = ca.solve_and_render(scene, oracle, quality)
-                renders["%s_%.1f" % (oracle.lower(), quality)] = image
-                e = image_agreement.compare(image, reference.image, reference.mask)
-                print("[agreement] %s %-10s q=%.1f: exposure %+6.1f %%, median block error %5.1f %% "
-                      "(%d blocks; %d elements, %s)" % (label, oracle.lower(), quality, 100 * e["exposure"],
-                                                        100 * e["block"], e["blocks"], stats.elements, stats.status),
-                      flush=True)
-                numbers = "%s %s q=%.1f: exposure %+.1f %% (tolerance %.0f %%), median block error %.1f %% " \
-                          "(tolerance %.0f %%)" % (label, oracle.lower(), quality, 100 * e["exposure"],
-                                                   100 * MEAN_TOLERANCE, 100 * e["block"], 100 * BLOCK_TOLERANCE)
-                with self.subTest(oracle=oracle, quality=quality):
-                    self.assertLess(abs(e["exposure"]), MEAN_TOLERANCE, numbers)
-                    self.assertLess(e["block"], BLOCK_TOLERANCE, numbers)
-        folder = os.environ.get("RADIOSITY_TEST_IMAGES")
-        if folder:
-            ca.save_pngs(folder, label, reference, renders)
+        ca.assert_agreement(self, label)
 
     def test_cornell_box_as_published(self):
         self.agree("cornell_box")

@@ -138,6 +138,28 @@ class Meshing(unittest.TestCase):
         # The floor under the box coincides with the box's bottom: one surface there.
         self.assertEqual(len(scene.coincident_faces), 1)
 
+    def test_sides_no_light_reaches_get_no_links_and_are_not_shown(self):
+        # The inside of a closed box on a lit floor sees only itself: no light
+        # reaches it, so it keeps no links and the output shows each of the
+        # box's faces once (its outside), not doubled.
+        b = SceneBuilder()
+        b.polygon([(0, 0, 0), (4, 0, 0), (4, 4, 0), (0, 4, 0)], rho=0.5)
+        box = b.box((1.3, 1.1, 0.2), (2.1, 1.9, 0.8), rho=0.5)  # floating: every outer side is lit
+        b.polygon([(1, 3, 3), (3, 3, 3), (3, 1, 3), (1, 1, 3)], rho=0.0, emission=5.0, two_sided=False)
+        result = rad.solve(b.scene(rad), oracle="standard", quality=0.3)
+        shown = {(int(f), int(s)) for f, s in zip(result.source_face, result.source_side) if f in box}
+        self.assertEqual(shown, {(f, 0) for f in box})
+        # The same box without its insides' links: the inner sides used to
+        # keep 30 links among themselves (each of 6 sides to the 5 others).
+        inner_links = rad.solve(b.scene(rad), oracle="standard", quality=0.0).stats["links"]
+        b2 = SceneBuilder()
+        b2.polygon([(0, 0, 0), (4, 0, 0), (4, 4, 0), (0, 4, 0)], rho=0.5)
+        for f in b2.box((1.3, 1.1, 0.2), (2.1, 1.9, 0.8), rho=0.5):
+            b2.two_sided[f] = False
+        b2.polygon([(1, 3, 3), (3, 3, 3), (3, 1, 3), (1, 1, 3)], rho=0.0, emission=5.0, two_sided=False)
+        one_sided_links = rad.solve(b2.scene(rad), oracle="standard", quality=0.0).stats["links"]
+        self.assertEqual(inner_links, one_sided_links)
+
     def test_legs_under_five_per_cent_of_the_floor_are_not_cut_around_unless_they_emit(self):
         # A 4 x 4 floor (diameter 5.66 m): 5 % is 28 cm. A 20 cm block stands
         # on it uncut; a 40 cm one, or a 20 cm lamp lying on it, is cut around.
