@@ -334,6 +334,43 @@ void DirectLight::sky(const Element& receiver, Values& out) const {
   }
 }
 
+double DirectLight::probe(const Light& light, const Element& receiver) const {
+  if (light.kind == LightKind::Sky) return 0.0;
+  dvec3 c[4];
+  const int nc = hierarchy_.corners(receiver, c);
+  const dvec3 n = hierarchy_.normal(receiver);
+  const std::uint32_t face = hierarchy_.patch_of(receiver).surface;
+  const dvec3 axis = glm::normalize(light.direction);
+  double largest = 0.0;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      double a = (i + 0.5) / 4.0, b = (j + 0.5) / 4.0;
+      dvec3 x;
+      if (nc == 4) {
+        x = (1 - a) * (1 - b) * c[0] + a * (1 - b) * c[1] + a * b * c[2] + (1 - a) * b * c[3];
+      } else {
+        if (a + b > 1.0) a = 1.0 - a, b = 1.0 - b;
+        x = (1 - a - b) * c[0] + a * c[1] + b * c[2];
+      }
+      double value = 0.0;
+      dvec3 to;
+      if (light.kind == LightKind::Sun) {
+        value = std::max(0.0, -glm::dot(n, axis));
+        to = x - far_ * axis;
+      } else {
+        const dvec3 d = light.position - x;
+        const double d2 = glm::dot(d, d);
+        if (!(d2 > 0.0)) continue;
+        const double len = std::sqrt(d2);
+        value = std::max(0.0, glm::dot(n, d)) / (d2 * len) * spot_factor(light, glm::dot(axis, -d / len)).value;
+        to = light.position;
+      }
+      if (value > largest && !occluders_.rays->occluded(x, to, face)) largest = value;
+    }
+  }
+  return largest;
+}
+
 bool DirectLight::evaluate(LightLink& link) const {
   const Element& receiver = hierarchy_.element(link.receiver);
   const Light& light = hierarchy_.scene().lights[link.light];
@@ -346,14 +383,17 @@ bool DirectLight::evaluate(LightLink& link) const {
   }
   dvec3 x[kMaxSamples];
   const int ns = hierarchy_.samples(receiver, x);
-  bool any = false;
-  double value[kMaxSamples];
+  double value[kMaxSamples], largest = 0.0;
   for (int s = 0; s < ns; ++s) {
     value[s] = std::max(0.0, values.value[s]);
     link.value[static_cast<size_t>(s)] = static_cast<float>(value[s]);
-    any |= value[s] > 0.0;
+    largest = std::max(largest, value[s]);
   }
-  if (!any) return false;
+  const double missed = probe(light, receiver);
+  link.missed = missed > 2.0 * largest ? static_cast<float>(missed) : 0.0f;
+  if (!(largest > 0.0) && !(link.missed > 0.0f)) return false;
+  link.oracle = 0.0f;
+  if (!(largest > 0.0)) return true;
   const LinkSamples samples{std::span<const dvec3>(x, static_cast<size_t>(ns)),
                             std::span<const double>(value, static_cast<size_t>(ns)),
                             std::span<const dvec3>(values.gradient, static_cast<size_t>(ns)),

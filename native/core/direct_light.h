@@ -38,6 +38,12 @@ struct LightLink {
   std::uint32_t light = 0;                       // index into Scene::lights
   std::array<float, kMaxSamples> value{};        // H per unit colour, at each receiver sample
   float oracle = 0.0f;  // geometric part of the oracle, as Link::oracle
+  // Light the samples miss: the largest value on a 4 x 4 grid over the
+  // receiver where it is more than twice the samples' largest (a spot's cone
+  // or a sunlit patch falling between the corners and the centre of a wall),
+  // else 0. The oracles judge only what the samples see; such a link splits
+  // its receiver until they see it.
+  float missed = 0.0f;
 };
 
 class DirectLight {
@@ -61,6 +67,9 @@ class DirectLight {
   void point_or_spot(const Light& light, const Element& receiver, Values& out) const;
   void sun(const Light& light, const Element& receiver, Values& out) const;
   void sky(const Element& receiver, Values& out) const;
+  // The light's value, unoccluded but for one shadow ray to its centre, at
+  // a 4 x 4 grid of points over the receiver: the largest (0 for the sky).
+  double probe(const Light& light, const Element& receiver) const;
   // Visible form factor of `polygon` (seen from x, shadows from `candidates`
   // or, sampled, from rays) for each sample; `polygon_at` builds the polygon
   // seen from a sample and `shaft` bounds every such polygon.

@@ -266,7 +266,7 @@ Scene make_scene(const SceneArrays& a) {
     scene.lights.push_back(sky);
   }
   if (!(scene.emitted_power > 0.0) && scene.lights.empty()) {
-    fail("the scene has no light: no face emits, and there is no light and no world colour");
+    fail("the scene has no emitter: no face emits, and there is no light and no world colour");
   }
   return scene;
 }

@@ -53,6 +53,10 @@ double cluster_separation(const SolveOptions& options) {
   return options.cluster_separation > 0.0 ? options.cluster_separation : 2.0 + 8.0 * options.quality;
 }
 
+// Light a light link's samples miss (LightLink::missed) is refined for when it
+// would reach this fraction of the radiance the eye adapts to.
+constexpr double kMissedLight = 0.01;
+
 // Shadow rays that measure a cluster link's visible fraction.
 constexpr int kClusterRays = 16;
 
@@ -482,7 +486,12 @@ bool Solver::refine_light_links(double threshold) {
       const LightLink& l = light_links_[i];
       const Element& p = hierarchy_.element(l.receiver);
       const double brightness = luminance(hierarchy_.reflectance(p) * lights[l.light].colour);
-      split[i] = p.is_leaf() && brightness / reference_radiance_ * l.oracle > threshold && can_split(l.receiver);
+      // Light the samples miss splits the receiver when it would show (a
+      // hundredth of the adaptation level) whatever the oracle: the oracle
+      // can only judge what the samples see.
+      const bool missed = brightness * l.missed > kMissedLight * reference_radiance_;
+      split[i] = p.is_leaf() && (missed || brightness / reference_radiance_ * l.oracle > threshold) &&
+                 can_split(l.receiver);
     }
   });
   for (size_t i = 0; i < light_links_.size(); ++i) {

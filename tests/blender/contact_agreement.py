@@ -157,9 +157,9 @@ BLOCK_TOLERANCE = 0.06
 NOISE_FRACTION = 0.25
 
 
-def assert_agreement(test, label, qualities=QUALITIES):
-    """Asserts (on `test`, a TestCase) that every oracle at `qualities` agrees with the path
-    trace of the case `label` within the tolerances, printing the numbers."""
+def assert_agreement(test, label, qualities=QUALITIES, oracles=ORACLES):
+    """Asserts (on `test`, a TestCase) that each of `oracles` at `qualities` agrees with the
+    path trace of the case `label` within the tolerances, printing the numbers."""
     scene = build_case(label)
     reference = Reference(label, scene)
     noise = reference.noise()
@@ -170,7 +170,7 @@ def assert_agreement(test, label, qualities=QUALITIES):
     test.assertLess(noise["exposure"], NOISE_FRACTION * MEAN_TOLERANCE)
     test.assertLess(noise["block"], NOISE_FRACTION * BLOCK_TOLERANCE)
     renders = {}
-    for oracle in ORACLES:
+    for oracle in oracles:
         for quality in qualities:
             image, stats = solve_and_render(scene, oracle, quality)
             renders["%s_%.1f" % (oracle.lower(), quality)] = image
