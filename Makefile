@@ -20,7 +20,7 @@ ifdef CI
 CMAKE_ARGS += -DRADIOSITY_WERROR=ON
 endif
 
-.PHONY: all deps portable configure build test unit demo scenes package bench figures clean blenders
+.PHONY: all deps portable configure build test unit demo scenes package bench figures clean blenders validator
 
 # The command that runs $(BLENDER), installing it first if it is a bpy not yet installed.
 BLENDER_EXE = "$$($(PYTHON) tools/blenders.py install --build $(BUILD) $(BLENDER) >&2 && \
@@ -49,12 +49,17 @@ build: deps portable configure
 
 # Unit tests (CTest), Python tests of the native module and the packages, and the
 # headless Blender tests in each of $(BLENDERS), with one summary line at the end.
-test: build package blenders
+test: build package blenders validator
 	@$(PYTHON) tests/run_tests.py --build $(BUILD) $(foreach b,$(BLENDERS),--blender $(b))
 
 # Installs each bpy of $(BLENDERS) that is missing (pinned; a no-op once there).
 blenders:
 	@$(PYTHON) tools/blenders.py install --build $(BUILD) $(BLENDERS)
+
+# The Khronos glTF validator (npm, pinned in tools/gltf_validator.py) in $(BUILD)/node,
+# for tests/blender/test_gltf_export.py (a no-op once there).
+validator: deps
+	@$(PYTHON) tools/gltf_validator.py install --build $(BUILD)
 
 scenes: build
 	@$(PYTHON) scenes/build_all.py --build $(BUILD) --blender $(BLENDER_EXE)

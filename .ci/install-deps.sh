@@ -11,6 +11,13 @@ packages=(
   xvfb libgl1-mesa-dri  # the interactive (modal, ESC) test runs Blender in a virtual display
 )
 
+# Node.js and npm run the Khronos glTF validator (tools/gltf_validator.py, which
+# installs the validator itself into the build tree). Checked by command: a
+# Node.js from elsewhere (NodeSource's nodejs, which includes npm) will do.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  packages+=(nodejs npm)
+fi
+
 missing=()
 for p in "${packages[@]}"; do
   status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)

@@ -24,14 +24,15 @@ if "bpy" in locals():
     # Re-running register after F8 / "Reload Scripts": pick up edited modules.
     import importlib
 
-    for _name in ("native", "compat", "geometry", "export", "bake", "properties", "operators", "ui"):
+    for _name in ("native", "compat", "geometry", "export", "bake", "display_colours",
+                  "game_export", "properties", "operators", "ui"):
         if _name in locals():
             importlib.reload(locals()[_name])
 
 import bpy
 from bpy.props import PointerProperty
 
-from . import native, operators, properties, ui
+from . import game_export, native, operators, properties, ui
 
 # Registration order matters: a PropertyGroup before the group that points to it.
 classes = (
@@ -40,6 +41,7 @@ classes = (
     operators.RADIOSITY_OT_solve,
     operators.RADIOSITY_OT_toggle_result,
     operators.RADIOSITY_OT_clear,
+    game_export.RADIOSITY_OT_export_gltf,
     ui.RENDER_PT_radiosity,
 )
 

@@ -130,8 +130,10 @@ def set_colour_attribute(mesh, rgb, domain):
     return attr
 
 
-def write_refined(scene, exported, result, show_wireframe=False):
-    """Replace the result objects by the solution's meshes. Returns the new objects."""
+def write_refined(scene, exported, result, show_wireframe=False, convert=None, material=None):
+    """Replace the result objects by the solution's meshes. Returns the new objects.
+    `convert` maps the (V, 3) radiance to the colours written and `material`
+    replaces "Radiosity Emission" (game-ready colours: game_export.bake_options)."""
     face_part = exported.arrays["face_part"]
     polygon_part = face_part[np.asarray(result.source_face, dtype=np.int64)]
     pieces = geometry.split_result(result.face_vertices, result.face_sizes, polygon_part,
@@ -143,7 +145,10 @@ def write_refined(scene, exported, result, show_wireframe=False):
         positions = geometry.offset_sides(positions, result.face_vertices, face_sizes,
                                           SIDE_OFFSET * extent)
     radiance = np.asarray(result.radiance)
-    material = emission_material()
+    if convert is not None:
+        radiance = convert(radiance)
+    if material is None:
+        material = emission_material()
     new_objects = []
     try:
         for part, piece in zip(exported.parts, pieces):
@@ -182,8 +187,9 @@ def set_wireframe(scene, show):
 
 # --- Original output ---------------------------------------------------------------------
 
-def write_original(scene, exported, result):
-    """Write a face-corner "Radiosity" attribute onto the original meshes.
+def write_original(scene, exported, result, convert=None):
+    """Write a face-corner "Radiosity" attribute onto the original meshes (`convert`
+    maps the (N, 3) radiance to the colours written, as in write_refined).
 
     Only for objects whose evaluated mesh has the original's topology (no
     generating modifiers), that are not instances and do not share their mesh.
@@ -213,6 +219,8 @@ def write_original(scene, exported, result):
     values, _ = geometry.corner_values(points, sizes, ids, result.positions, result.face_vertices,
                                        result.face_sizes, result.source_face, result.source_side,
                                        result.radiance, tolerance=1e-7 * max(extent, 1e-9))
+    if convert is not None:
+        values = convert(values)
     offset = 0
     for part, _, obj, mesh in targets:
         n = int(part.face_sizes.sum())

@@ -23,7 +23,7 @@ import bpy
 import numpy as np
 from bpy.types import Operator
 
-from . import bake, export, native
+from . import bake, export, game_export, native
 
 STATUS = {
     "quality": "Converged",
@@ -265,18 +265,24 @@ class RADIOSITY_OT_solve(Operator):
         settings = scene.radiosity
         mode = settings.output
         skipped_objects = []
+        warnings = []
+        convert = material = None
+        if settings.display_colours:
+            convert, material, note = game_export.bake_options(scene)
+            if note:
+                warnings.append(note)
         if mode in {'REFINED', 'BOTH'}:
-            bake.write_refined(scene, job.exported, result, settings.show_wireframe)
+            bake.write_refined(scene, job.exported, result, settings.show_wireframe,
+                               convert=convert, material=material)
             bake.hide_originals(scene, context.view_layer, job.exported.hidden_sources)
             bake.show_results(scene, True)
         else:
             bake.remove_results(scene)
             bake.restore_originals(scene, context.view_layer)
         if mode in {'ORIGINAL', 'BOTH'}:
-            skipped_objects = bake.write_original(scene, job.exported, result)
+            skipped_objects = bake.write_original(scene, job.exported, result, convert=convert)
         bake.set_viewport_attribute_colour()
 
-        warnings = []
         note = export.unmodelled_message(job.exported.unmodelled)
         if note:
             warnings.append(note)

@@ -194,6 +194,27 @@ class RadiositySettings(PropertyGroup):
         default=False,
         update=_update_wireframe,
     )
+    # Game-ready colours (issue 15; game_export.py, display_colours.py).
+    display_colours: BoolProperty(
+        name="Game-Ready Colours",
+        description=(
+            "Bake display-ready colours for game engines instead of radiance: exposure, "
+            "the scene's view transform (Color Management) and a clamp to 0-1, shown "
+            "through an unlit material that the glTF exporter writes as KHR_materials_unlit "
+            "with the colours as COLOR_0"
+        ),
+        default=False,
+    )
+    display_exposure: FloatProperty(
+        name="Exposure",
+        description=(
+            "Exposure of the game-ready colours in stops (radiance times 2^exposure), "
+            "added to the scene's Color Management exposure"
+        ),
+        soft_min=-10.0,
+        soft_max=10.0,
+        default=0.0,
+    )
     stats: PointerProperty(type=RadiosityStats)
 
     def solver_options(self):

@@ -47,6 +47,12 @@ class RENDER_PT_radiosity(Panel):
         col.prop(settings, "output")
         col.prop(settings, "show_wireframe")
 
+        col = layout.column(heading="Game Export")
+        col.prop(settings, "display_colours")
+        sub = col.column()
+        sub.active = settings.display_colours
+        sub.prop(settings, "display_exposure")
+
         layout.separator()
         row = layout.row()
         row.scale_y = 1.5
@@ -54,6 +60,7 @@ class RENDER_PT_radiosity(Panel):
         row = layout.row(align=True)
         row.operator("radiosity.toggle_result", icon='HIDE_OFF')
         row.operator("radiosity.clear", icon='X')
+        layout.operator("radiosity.export_gltf", icon='EXPORT')
         if native.error() is not None:
             box = layout.box()
             box.alert = True

@@ -23,6 +23,7 @@ ADDON_TYPES = (
     (bpy.types.Operator, "RADIOSITY_OT_solve"),
     (bpy.types.Operator, "RADIOSITY_OT_toggle_result"),
     (bpy.types.Operator, "RADIOSITY_OT_clear"),
+    (bpy.types.Operator, "RADIOSITY_OT_export_gltf"),
     (bpy.types.Panel, "RENDER_PT_radiosity"),
 )
 
@@ -201,7 +202,8 @@ class PanelTest(unittest.TestCase):
         # The add-on's own settings; `stats` is drawn as labels.
         settings = set(properties.RadiositySettings.__annotations__) - {"stats"}
         self.assertEqual(drawn, settings)
-        self.assertEqual(record["operators"], ["radiosity.solve", "radiosity.toggle_result", "radiosity.clear"])
+        self.assertEqual(record["operators"], ["radiosity.solve", "radiosity.toggle_result", "radiosity.clear",
+                                               "radiosity.export_gltf"])
         self.assertIn("Not solved yet", record["labels"])
 
     def test_draws_last_solve_statistics(self):
