@@ -264,8 +264,8 @@ class RADIOSITY_OT_solve(Operator):
         settings = scene.radiosity
         mode = settings.output
         skipped_objects = []
-        if mode in {'REFINED', 'BOTH'}:
-            bake.write_refined(scene, job.exported, result, settings.show_wireframe)
+        if mode in {'REFINED', 'BOTH', 'LIGHTING'}:
+            bake.write_refined(scene, job.exported, result, settings.show_wireframe, lighting=mode == 'LIGHTING')
             bake.hide_originals(scene, context.view_layer, job.exported.hidden_sources)
             bake.show_results(scene, True)
         else:

@@ -46,6 +46,10 @@ OUTPUT_ITEMS = (
      "without refinement"),
     ('BOTH', "Both",
      "Write refined meshes and the attribute on the original meshes"),
+    ('LIGHTING', "Lighting Only (Keep Materials)",
+     "Write refined meshes like Refined Meshes, each with copies of its original's "
+     "materials (textures included) lit by the solution's 'Radiosity Light' attribute "
+     "(the light before the surface's colour); the originals are untouched"),
 )
 
 

@@ -153,12 +153,36 @@ def interpolate(face_points, face_sizes, triangles, triangle_face, values, query
     return out[:, 0] if squeeze else out
 
 
-def part_corner_queries(face_vertices, face_sizes, polygon_part, source_face, part, first_face):
-    """The result corners of part `part`, in the order its mesh is built
-    (geometry.split_result): (result vertex per corner, local input face per corner)."""
-    face_sizes = np.asarray(face_sizes, dtype=np.int64)
-    corner_polygon = np.repeat(np.arange(len(face_sizes)), face_sizes)
-    mask = np.asarray(polygon_part, dtype=np.int64)[corner_polygon] == part
-    vertices = np.asarray(face_vertices, dtype=np.int64)[mask]
-    faces = np.asarray(source_face, dtype=np.int64)[corner_polygon[mask]] - int(first_face)
-    return vertices, faces
+def part_corner_queries(face_vertices, face_starts, face_sizes, polygons, source_face, first_face):
+    """The corners of result polygons `polygons` (one part's, ascending: the order
+    geometry.split_result builds its mesh in): (result vertex of each corner, the
+    part's input face of each corner, counted from `first_face`)."""
+    polygons = np.asarray(polygons, dtype=np.int64)
+    sizes = np.asarray(face_sizes, dtype=np.int64)[polygons]
+    offsets = np.cumsum(sizes) - sizes
+    k = np.arange(int(sizes.sum()), dtype=np.int64) - np.repeat(offsets, sizes)
+    corners = np.repeat(np.asarray(face_starts, dtype=np.int64)[polygons], sizes) + k
+    faces = np.repeat(np.asarray(source_face, dtype=np.int64)[polygons], sizes) - int(first_face)
+    return np.asarray(face_vertices, dtype=np.int64)[corners], faces
+
+
+class LoopUVs:
+    """The UV maps and loop triangles of one evaluated mesh, per Blender loop
+    (export.py reads them; `corners` puts them in the exported corner order)."""
+
+    def __init__(self, layers, render, loop_start, loop_total, triangle_loops, triangle_polygon):
+        self.layers = layers                  # {name: (L, 2)} in the mesh's order
+        self.render = render                  # name of the render UV map ("" if none)
+        self.loop_start = np.asarray(loop_start, dtype=np.int64)
+        self.loop_total = np.asarray(loop_total, dtype=np.int64)
+        self.triangle_loops = np.asarray(triangle_loops, dtype=np.int64).reshape(-1, 3)
+        self.triangle_polygon = np.asarray(triangle_polygon, dtype=np.int64)
+
+    def corners(self, mirrored=False):
+        """({name: (C, 2) float32}, triangles (T, 3) corner indices, triangle_face (T,))
+        in the exported corner order (polygon order; reversed polygons if mirrored)."""
+        flat = flat_loop_order(self.loop_start, self.loop_total, mirrored)
+        layers = {name: loop_values_to_flat(uv, flat).astype(np.float32) for name, uv in self.layers.items()}
+        loop_count = int((self.loop_start + self.loop_total).max(initial=0))
+        triangles = loop_triangles_to_flat(self.triangle_loops, flat, loop_count)
+        return layers, triangles, self.triangle_polygon.copy()

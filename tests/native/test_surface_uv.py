@@ -25,6 +25,21 @@ class LoopOrderTest(unittest.TestCase):
         uv = np.arange(14.0).reshape(7, 2)
         np.testing.assert_array_equal(surface_uv.loop_values_to_flat(uv, flat)[0], uv[3])
 
+    def test_loop_uvs_in_corner_order(self):
+        # A quad (loops 3..6) and a triangle (loops 0..2), mirrored.
+        uv = np.arange(14.0).reshape(7, 2)
+        loops = surface_uv.LoopUVs({"UVMap": uv}, "UVMap", [3, 0], [4, 3], [[3, 4, 5], [3, 5, 6], [0, 1, 2]],
+                                   [0, 0, 1])
+        layers, tris, face = loops.corners(mirrored=True)
+        self.assertEqual(set(layers), {"UVMap"})
+        self.assertEqual(layers["UVMap"].dtype, np.float32)
+        np.testing.assert_array_equal(face, [0, 0, 1])
+        flat = surface_uv.flat_loop_order([3, 0], [4, 3], mirrored=True)
+        np.testing.assert_array_equal(flat, [6, 5, 4, 3, 2, 1, 0])
+        np.testing.assert_array_equal(layers["UVMap"], uv[flat])
+        # Each triangle's corners name the same loops as before.
+        np.testing.assert_array_equal(flat[tris], [[3, 4, 5], [3, 5, 6], [0, 1, 2]])
+
 
 class BlenderTrianglesTest(unittest.TestCase):
     def test_convex_quad_splits_along_0_2(self):
@@ -97,8 +112,8 @@ class InterpolateTest(unittest.TestCase):
 
     def test_part_corner_queries(self):
         # Three result polygons: parts 1, 0, 1; part 1's input faces start at 10.
-        vertices, faces = surface_uv.part_corner_queries([0, 1, 2, 3, 4, 5, 6, 7, 8, 9], [3, 3, 4], [1, 0, 1],
-                                                         [10, 2, 11], 1, 10)
+        vertices, faces = surface_uv.part_corner_queries([0, 1, 2, 3, 4, 5, 6, 7, 8, 9], [0, 3, 6], [3, 3, 4],
+                                                         [0, 2], [10, 2, 11], 10)
         np.testing.assert_array_equal(vertices, [0, 1, 2, 6, 7, 8, 9])
         np.testing.assert_array_equal(faces, [0, 0, 0, 1, 1, 1, 1])
 
