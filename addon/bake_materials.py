@@ -36,19 +36,21 @@ SUFFIX = " Radiosity Light"
 def add_light_attribute(mesh, irradiance):
     """Write the point-domain FLOAT_COLOR attribute "Radiosity Light" (H per vertex),
     leaving the active and render colour as they are."""
-    old = mesh.color_attributes.get(LIGHT_ATTRIBUTE)
+    colours = mesh.color_attributes
+    old = colours.get(LIGHT_ATTRIBUTE)
     if old is not None:
-        mesh.color_attributes.remove(old)
-    active = mesh.color_attributes.active_color_index if hasattr(mesh.color_attributes, "active_color_index") \
-        else None
-    render = mesh.color_attributes.render_color_index
-    attr = mesh.color_attributes.new(LIGHT_ATTRIBUTE, 'FLOAT_COLOR', 'POINT')
+        colours.remove(old)
+    active = colours.active_color.name if colours.active_color is not None else None
+    render = colours[colours.render_color_index].name if 0 <= colours.render_color_index < len(colours) else None
+    attr = colours.new(LIGHT_ATTRIBUTE, 'FLOAT_COLOR', 'POINT')
     rgba = np.ones((len(irradiance), 4), dtype=np.float32)
     rgba[:, :3] = irradiance
     attr.data.foreach_set("color", rgba.ravel())
-    if active is not None and active >= 0:
-        mesh.color_attributes.active_color_index = active
-    mesh.color_attributes.render_color_index = render
+    names = [a.name for a in colours]
+    if active is not None:
+        colours.active_color = colours[active]
+    if render is not None:
+        colours.render_color_index = names.index(render)
     return attr
 
 
