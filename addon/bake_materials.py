@@ -112,13 +112,14 @@ def remove_unused():
 
 def lighting_copy(material):
     """A new material that shows `material` lit by "Radiosity Light" (None: the default surface)."""
+    name = DEFAULT_MATERIAL if material is None else material.name + SUFFIX
     if material is None:
-        copy = bpy.data.materials.new(DEFAULT_MATERIAL)
+        copy = bpy.data.materials.new(name)
         copy[COPY_TAG] = ""
         _emission_only(copy, DEFAULT_COLOUR)
     else:
         copy = material.copy()
-        copy.name = material.name + SUFFIX
+        copy.name = name
         copy[COPY_TAG] = material.name_full
         copy.use_fake_user = False
         if not copy.use_nodes or copy.node_tree is None:
@@ -126,7 +127,7 @@ def lighting_copy(material):
             _emission_only(copy, tuple(material.diffuse_color[:3]))
         else:
             _relight(copy.node_tree)
-    copy[COPY_TAG + "_name"] = copy.name
+    copy[COPY_TAG + "_name"] = name    # the name it takes once the last bake's copies are gone
     _backs_transparent(copy.node_tree)
     compat.set_cutout_transparency(copy)
     return copy

@@ -136,10 +136,12 @@ def build_textured_room(scene):
                 obj.data.uv_layers["UVMap"].active_render = True
     light = bpy.data.lights.new("Area", 'AREA')
     light.shape = 'RECTANGLE'
-    light.size, light.size_y = 0.8, 0.6
+    light.size, light.size_y = 0.6, 0.5
     light.energy = 30.0
     obj = bpy.data.objects.new("Area", light)
-    obj.location = (0.3, 0.4, 2.3)
+    # Above the camera, out of its view (Cycles does not show an area light to
+    # the camera; the solution's light polygon would be seen).
+    obj.location = (1.0, -1.0, 2.4)
     scene.collection.objects.link(obj)
     kit.add_camera(scene, location=(1.2, -1.3, 1.5), target=(-0.6, 0.8, 0.5), lens=14.0)
     kit.setup_render(scene, resolution=RESOLUTION)
@@ -369,12 +371,16 @@ class LightingBakeTest(unittest.TestCase):
         bare = kit.add_mesh(cls.scene, "Bare box", kit.box((0.2, 0.2, 0.2)), white_placeholder(),
                             location=(0.6, 0.6, 0.3))
         bare.data.materials.clear()
+        cls.scene.view_layers[0].update()
         cls.before = originals_snapshot(cls.scene)
         cls.scene.radiosity.output = 'LIGHTING'
         cls.scene.radiosity.quality = 0.2
         cls.status = bpy.ops.radiosity.solve()
         cls.after_solve = originals_snapshot(cls.scene)
-        cls.results = {o[export.RESULT_TAG]: o for o in bake.result_objects(cls.scene)}
+
+    @property
+    def results(self):
+        return {o[export.RESULT_TAG]: o for o in bake.result_objects(self.scene)}
 
     def test_solved(self):
         self.assertEqual(self.status, {'FINISHED'})
@@ -450,7 +456,6 @@ class LightingBakeTest(unittest.TestCase):
         self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})   # a re-solve keeps the names
         self.assertEqual(sorted(m.name for m in bpy.data.materials if m.get(bake_materials.COPY_TAG) is not None),
                          names)
-        type(self).results = {o[export.RESULT_TAG]: o for o in bake.result_objects(scene)}
 
 
 def white_placeholder():
