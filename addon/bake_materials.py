@@ -126,7 +126,7 @@ def lighting_copy(material):
             # Cycles renders a material without nodes as diffuse of its viewport colour.
             _emission_only(copy, tuple(material.diffuse_color[:3]))
         else:
-            _relight(copy.node_tree)
+            _relight(copy.node_tree, tuple(material.diffuse_color[:3]))
     copy[COPY_TAG + "_name"] = name    # the name it takes once the last bake's copies are gone
     _backs_transparent(copy.node_tree)
     compat.set_cutout_transparency(copy)
@@ -159,12 +159,12 @@ def _light_node(tree):
 
 
 def _source(socket):
-    """(the output socket feeding `socket` or None, its constant rgb)."""
+    """(the output socket feeding `socket` or None, its constant rgb). A muted or
+    invalid link passes the input's own value, as in a render."""
     if socket.is_linked:
         link = socket.links[0]
         if link.is_valid and not link.is_muted:
             return link.from_socket, None
-        return None, (0.0, 0.0, 0.0)
     value = socket.default_value
     try:
         rgb = tuple(value[:3])
@@ -217,19 +217,26 @@ def _principled_emission(tree, node, location):
 _KEPT = {'EMISSION', 'MIX_SHADER', 'ADD_SHADER', 'BSDF_TRANSPARENT', 'HOLDOUT', 'BACKGROUND'}
 
 
-def _relight(tree):
-    """Replace every BSDF of `tree` by the Emission it shows under "Radiosity Light"."""
+def _relight(tree, viewport):
+    """Replace every BSDF of `tree` by the Emission it shows under "Radiosity Light".
+    A node group that outputs a shader (unknown inside, as to export.py) becomes
+    the viewport colour `viewport` lit."""
     light = _light_node(tree)
     light.location = (-900, 400)
     for node in list(tree.nodes):
-        if not (node.type.startswith('BSDF_') or node.type == 'SUBSURFACE_SCATTERING') or node.type in _KEPT:
+        group = node.type == 'GROUP' and any(o.type == 'SHADER' for o in node.outputs)
+        if not (group or node.type.startswith('BSDF_') or node.type == 'SUBSURFACE_SCATTERING') \
+                or node.type in _KEPT:
             continue
         x, y = node.location
+        base = None
         if node.type == 'BSDF_PRINCIPLED':
             base = node.inputs["Base Color"]
-        else:
+        elif not group:
             base = node.inputs.get("Color")
-        if base is not None:
+        if group:
+            colour = _multiply_by_light(tree, light, None, viewport, (x - 50, y - 300))
+        elif base is not None:
             source, constant = _source(base)
             colour = _multiply_by_light(tree, light, source, constant, (x - 50, y - 300))
         else:
@@ -254,7 +261,8 @@ def _relight(tree):
                 continue
             for link in list(output.links):
                 tree.links.new(emission.outputs[0], link.to_socket)
-        tree.nodes.remove(node)
+        if not group:       # a group's other outputs may feed other nodes
+            tree.nodes.remove(node)
 
 
 def _backs_transparent(tree):
