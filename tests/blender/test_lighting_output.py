@@ -371,6 +371,7 @@ class LightingBakeTest(unittest.TestCase):
         bare = kit.add_mesh(cls.scene, "Bare box", kit.box((0.2, 0.2, 0.2)), white_placeholder(),
                             location=(0.6, 0.6, 0.3))
         bare.data.materials.clear()
+        add_sign(cls.scene, principled)
         cls.scene.view_layers[0].update()
         cls.before = originals_snapshot(cls.scene)
         cls.scene.radiosity.output = 'LIGHTING'
@@ -443,6 +444,20 @@ class LightingBakeTest(unittest.TestCase):
                         np.testing.assert_allclose(uv_values(mesh, layer), planar_uv(points, origin, u, v, scale),
                                                    atol=1e-4)
 
+    def test_uv_maps_follow_blenders_triangles_mirrored(self):
+        # Random UVs per corner are linear only over each of Blender's loop
+        # triangles: the result must take them from the triangle it lies in,
+        # also for an n-gon and through a mirroring transform.
+        sign = self.scene.objects["Sign"]
+        mesh = self.results["Sign"].data
+        points, uv = corner_points_and_uvs(mesh, "UVMap")
+        expected = blender_uvs_at(sign, "UVMap", points)
+        corners = np.array([sign.matrix_world @ v.co for v in sign.data.vertices])
+        inside = np.linalg.norm(points[:, None] - corners[None], axis=2).min(axis=1) > 0.01
+        self.assertGreater(inside.sum(), 20)     # refined: points inside the faces
+        self.assertFalse(np.isnan(expected).any())
+        np.testing.assert_allclose(uv, expected, atol=2e-4)
+
     def test_originals_untouched_after_clear(self):
         scene = self.scene
         self.assertEqual(bpy.ops.radiosity.clear(), {'FINISHED'})
@@ -456,6 +471,61 @@ class LightingBakeTest(unittest.TestCase):
         self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})   # a re-solve keeps the names
         self.assertEqual(sorted(m.name for m in bpy.data.materials if m.get(bake_materials.COPY_TAG) is not None),
                          names)
+
+
+def add_sign(scene, material):
+    """"Sign": a quad and, apart from it, a hexagon (an n-gon) with random UVs per
+    corner, floating under the light, mirrored (scale -1 in x)."""
+    hexagon = [(0.25 + 0.15 * np.cos(a), 0.15 * np.sin(a), 0.0) for a in np.linspace(0, 2 * np.pi, 6, endpoint=False)]
+    quad = [(-0.4, -0.15, 0.0), (-0.05, -0.2, 0.0), (-0.1, 0.15, 0.0), (-0.35, 0.1, 0.0)]
+    mesh = bpy.data.meshes.new("Sign")
+    mesh.from_pydata(quad + hexagon, [], [list(range(4)), list(range(4, 10))])
+    mesh.materials.append(material)
+    layer = mesh.uv_layers.new(name="UVMap")
+    rng = np.random.default_rng(7)
+    compat.set_uv_layer(layer, rng.uniform(0, 1, (len(mesh.loops), 2)))
+    obj = bpy.data.objects.new("Sign", mesh)
+    # Close under the light, tilted: its light varies, so it is refined.
+    obj.location = (0.8, -0.7, 1.9)
+    obj.scale = (-1.5, 1.5, 1.5)
+    obj.rotation_euler = (0.3, 0.0, 0.4)
+    scene.collection.objects.link(obj)
+    return obj
+
+
+def corner_points_and_uvs(mesh, name):
+    """(C, 3) positions of a result mesh's corners and their (C, 2) UVs."""
+    co = np.empty(3 * len(mesh.vertices))
+    mesh.vertices.foreach_get("co", co)
+    loops = np.empty(len(mesh.loops), dtype=np.int64)
+    mesh.loops.foreach_get("vertex_index", loops)
+    return co.reshape(-1, 3)[loops], uv_values(mesh, name)
+
+
+def blender_uvs_at(obj, name, points, tolerance=1e-4):
+    """UVs of `obj` at world points as Blender interpolates them: over the mesh's
+    loop triangles (read here straight from Blender), the triangle containing the point."""
+    mesh = obj.data
+    mesh.calc_loop_triangles() if hasattr(mesh, "calc_loop_triangles") else None
+    world = np.array(obj.matrix_world)
+    co = np.array([(world @ np.append(v.co[:], 1.0))[:3] for v in mesh.vertices])
+    uv = uv_values(mesh, name)
+    out = np.full((len(points), 2), np.nan)
+    best = np.full(len(points), -np.inf)
+    for tri in mesh.loop_triangles:
+        loops = list(tri.loops)
+        a, b, c = (co[mesh.loops[i].vertex_index] for i in loops)
+        n = np.cross(b - a, c - a)
+        n /= np.linalg.norm(n)
+        on_plane = np.abs((points - a) @ n) < tolerance
+        m = np.column_stack([b - a, c - a])
+        st = np.linalg.lstsq(m, (points - a).T, rcond=None)[0].T
+        w = np.column_stack([1 - st.sum(axis=1), st])
+        score = np.where(on_plane, w.min(axis=1), -np.inf)
+        better = score > np.maximum(best, -tolerance)
+        out[better] = w[better] @ uv[loops]
+        best = np.maximum(best, score)
+    return out
 
 
 def white_placeholder():
