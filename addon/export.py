@@ -9,6 +9,8 @@ What is exported, as a Cycles render would see it:
   Diffuse BSDF Color, the average of an image texture feeding either, else the
   viewport colour) and emitted radiance (Emission colour x strength of a
   Principled BSDF or an Emission shader);
+- per face corner the UV maps, and each face's loop triangles (how Blender
+  renders it), for the UV maps of the refined result (surface_uv.py);
 - area lights as one-sided emitting polygons (rectangle, square, disk, ellipse)
   that cast no shadow (Cycles lets light through a light object: measured)
   with Blender's power-to-radiance conversion (geometry.area_light_radiance).
