@@ -9,6 +9,10 @@
   polygons facing away from each other, and each is seen only from its side.
   A re-solve replaces them; the originals are never edited, only hidden in
   renders and viewport while the result is shown (reversibly, `restore_originals`).
+- Lighting-only output (bake_materials.py): the refined objects with copies of
+  their originals' materials, lit by the attribute "Radiosity Light" (H, the
+  light before reflectance), which every refined mesh carries, with the
+  originals' UV maps.
 - Original output: a face-corner "Radiosity" attribute on the original meshes,
   sampled from the solution at their corners, without refinement.
 """
@@ -18,7 +22,7 @@ import json
 import bpy
 import numpy as np
 
-from . import compat, geometry
+from . import bake_materials, compat, geometry, surface_uv
 from .export import HIDDEN_TAG, RESULT_TAG
 
 COLLECTION_NAME = "Radiosity"
@@ -59,6 +63,7 @@ def remove_results(scene):
         bpy.data.objects.remove(obj)
         if mesh is not None and mesh.users == 0:
             bpy.data.meshes.remove(mesh)
+    bake_materials.remove_unused()
 
 
 def emission_material():
@@ -99,8 +104,9 @@ def emission_material():
 
 # --- Refined output ----------------------------------------------------------------------
 
-def build_mesh(name, positions, face_vertices, face_sizes, radiance):
-    """A new mesh from arrays, with the point-domain "Radiosity" colour attribute."""
+def build_mesh(name, positions, face_vertices, face_sizes, radiance, light=None):
+    """A new mesh from arrays, with the point-domain "Radiosity" colour attribute
+    (and "Radiosity Light", H per vertex, if `light` is given)."""
     face_sizes = np.asarray(face_sizes, dtype=np.int32)
     mesh = bpy.data.meshes.new(name)
     mesh.vertices.add(len(positions))
@@ -111,6 +117,8 @@ def build_mesh(name, positions, face_vertices, face_sizes, radiance):
     starts = (np.cumsum(face_sizes) - face_sizes).astype(np.int32)
     compat.set_polygon_loops(mesh.polygons, starts, face_sizes)
     mesh.update(calc_edges=True)
+    if light is not None:
+        bake_materials.add_light_attribute(mesh, light)
     set_colour_attribute(mesh, radiance, 'POINT')
     return mesh
 
@@ -130,16 +138,19 @@ def set_colour_attribute(mesh, rgb, domain):
     return attr
 
 
-def write_refined(scene, exported, result, show_wireframe=False, convert=None, material=None):
+def write_refined(scene, exported, result, show_wireframe=False, convert=None, material=None,
+                  lighting=False):
     """Replace the result objects by the solution's meshes. Returns the new objects.
     `convert` maps the (V, 3) radiance to the colours written and `material`
-    replaces "Radiosity Emission" (game-ready colours: game_export.bake_options)."""
+    replaces "Radiosity Emission" (game-ready colours: game_export.bake_options).
+    `lighting`: with lighting copies of the originals' materials (bake_materials.py)
+    instead (the copies of lights' parts keep `material`)."""
     face_part = exported.arrays["face_part"]
     polygon_part = face_part[np.asarray(result.source_face, dtype=np.int64)]
     pieces = geometry.split_result(result.face_vertices, result.face_sizes, polygon_part,
                                    len(exported.parts))
     face_sizes = np.asarray(result.face_sizes)
-    positions = np.asarray(result.positions)
+    positions = unmoved = np.asarray(result.positions)
     if len(positions):
         extent = float(np.ptp(positions, axis=0).max())
         positions = geometry.offset_sides(positions, result.face_vertices, face_sizes,
@@ -149,15 +160,27 @@ def write_refined(scene, exported, result, show_wireframe=False, convert=None, m
         radiance = convert(radiance)
     if material is None:
         material = emission_material()
+    light = np.asarray(result.vertex_irradiance)
+    source_face = np.asarray(result.source_face, dtype=np.int64)
+    first_face = np.searchsorted(face_part, np.arange(len(exported.parts)))
+    face_starts = np.cumsum(face_sizes) - face_sizes
+    copies = bake_materials.LightingMaterials() if lighting else None
     new_objects = []
     try:
-        for part, piece in zip(exported.parts, pieces):
+        for index, (part, piece) in enumerate(zip(exported.parts, pieces)):
             if piece is None:
                 continue
             polygons, vertices, local = piece
             name = "%s Radiosity" % part.name
-            mesh = build_mesh(name, positions[vertices], local, face_sizes[polygons], radiance[vertices])
-            mesh.materials.append(material)
+            mesh = build_mesh(name, positions[vertices], local, face_sizes[polygons], radiance[vertices],
+                              light[vertices])
+            corner_vertices, corner_faces = surface_uv.part_corner_queries(
+                result.face_vertices, face_starts, face_sizes, polygons, source_face, first_face[index])
+            bake_materials.add_uv_layers(mesh, part, unmoved[corner_vertices], corner_faces)
+            if copies is not None and not part.is_light:
+                copies.assign(mesh, part, source_face[polygons] - first_face[index])
+            else:
+                mesh.materials.append(material)
             obj = bpy.data.objects.new(name, mesh)
             obj[RESULT_TAG] = part.source
             obj["radiosity_name"] = name
@@ -169,6 +192,7 @@ def write_refined(scene, exported, result, show_wireframe=False, convert=None, m
             mesh = obj.data
             bpy.data.objects.remove(obj)
             bpy.data.meshes.remove(mesh)
+        bake_materials.remove_unused()
         raise
     remove_results(scene)
     coll = result_collection(scene)
@@ -176,6 +200,8 @@ def write_refined(scene, exported, result, show_wireframe=False, convert=None, m
         coll.objects.link(obj)
         # Made while the old results still held the names: take them back.
         obj.name = obj.data.name = obj["radiosity_name"]
+    if copies is not None:
+        copies.take_names()
     return new_objects
 
 

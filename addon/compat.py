@@ -61,3 +61,25 @@ def set_cutout_transparency(material):
     else:
         material.blend_method = 'CLIP'
         material.shadow_method = 'NONE'
+
+
+def get_uv_layer(layer, loop_count):
+    """A UV map's values per loop, (L, 2) float32: `layer.uv` (vectors, since 3.5)
+    or `layer.data` (MeshUVLoop, 3.x)."""
+    out = np.empty(2 * loop_count, dtype=np.float32)
+    vectors = getattr(layer, "uv", None)
+    if vectors is not None and len(vectors) == loop_count:
+        vectors.foreach_get("vector", out)
+    else:
+        layer.data.foreach_get("uv", out)
+    return out.reshape(-1, 2)
+
+
+def set_uv_layer(layer, values):
+    """Write a UV map's values per loop ((L, 2)), the inverse of get_uv_layer."""
+    flat = np.ascontiguousarray(values, dtype=np.float32).ravel()
+    vectors = getattr(layer, "uv", None)
+    if vectors is not None and 2 * len(vectors) == len(flat):
+        vectors.foreach_set("vector", flat)
+    else:
+        layer.data.foreach_set("uv", flat)

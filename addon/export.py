@@ -9,6 +9,8 @@ What is exported, as a Cycles render would see it:
   Diffuse BSDF Color, the average of an image texture feeding either, else the
   viewport colour) and emitted radiance (Emission colour x strength of a
   Principled BSDF or an Emission shader);
+- per face corner the UV maps, and each face's loop triangles (how Blender
+  renders it), for the UV maps of the refined result (surface_uv.py);
 - area lights as one-sided emitting polygons (rectangle, square, disk, ellipse)
   that cast no shadow (Cycles lets light through a light object: measured)
   with Blender's power-to-radiance conversion (geometry.area_light_radiance);
@@ -25,7 +27,7 @@ from dataclasses import dataclass, field
 import bpy
 import numpy as np
 
-from . import compat, geometry, light_units
+from . import compat, geometry, light_units, surface_uv
 
 # Objects the add-on itself made, which must never be solved again.
 RESULT_TAG = "radiosity_result"
@@ -48,6 +50,13 @@ class Part:
     face_sizes: np.ndarray = None      # (F,) corners per face
     materials: list = field(default_factory=list)  # material per face slot (None for none)
     material_index: np.ndarray = None  # (F,) slot of each face
+    # UV maps per corner of its faces (same order as corner_points), {name: (C, 2)},
+    # the render UV map's name, and the faces' triangles as Blender renders them
+    # ((T, 3) corner indices, (T,) face of each): surface_uv.py.
+    uv_layers: dict = field(default_factory=dict)
+    uv_render: str = ""
+    triangles: np.ndarray = None
+    triangle_face: np.ndarray = None
 
 
 @dataclass
@@ -195,7 +204,8 @@ def _scalar(socket, default):
 
 
 def _mesh_arrays(obj_eval):
-    """(positions (V,3) local, corners, face sizes, material index) of an evaluated object."""
+    """(positions (V,3) local, corners, face sizes, material index, surface_uv.LoopUVs
+    or None) of an evaluated object."""
     mesh = obj_eval.to_mesh()
     try:
         nv, nl, npoly = len(mesh.vertices), len(mesh.loops), len(mesh.polygons)
@@ -209,10 +219,27 @@ def _mesh_arrays(obj_eval):
         mesh.polygons.foreach_get("loop_start", loop_start)
         mesh.polygons.foreach_get("loop_total", loop_total)
         mesh.polygons.foreach_get("material_index", material_index)
+        uvs = _mesh_uvs(mesh, loop_start, loop_total)
     finally:
         obj_eval.to_mesh_clear()
     corners = geometry.polygon_corners(loop_start, loop_total, loop_vertex)
-    return positions.reshape(-1, 3), corners, loop_total.astype(np.int64), material_index
+    return positions.reshape(-1, 3), corners, loop_total.astype(np.int64), material_index, uvs
+
+
+def _mesh_uvs(mesh, loop_start, loop_total):
+    """The UV maps and loop triangles of a mesh (surface_uv.LoopUVs), None without UV maps."""
+    if len(mesh.uv_layers) == 0:
+        return None
+    layers = {layer.name: compat.get_uv_layer(layer, len(mesh.loops)) for layer in mesh.uv_layers}
+    render = next((layer.name for layer in mesh.uv_layers if layer.active_render), mesh.uv_layers[0].name)
+    if hasattr(mesh, "calc_loop_triangles"):
+        mesh.calc_loop_triangles()
+    count = len(mesh.loop_triangles)
+    loops = np.empty(3 * count, dtype=np.int32)
+    polygon = np.empty(count, dtype=np.int32)
+    mesh.loop_triangles.foreach_get("loops", loops)
+    mesh.loop_triangles.foreach_get("polygon_index", polygon)
+    return surface_uv.LoopUVs(layers, render, loop_start, loop_total, loops, polygon)
 
 
 def _renderable(obj):
@@ -278,11 +305,12 @@ def export_scene(context, blender_version=None):
             continue
         if obj.type not in GEOMETRY_TYPES:
             continue
-        positions, corners, sizes, material_index = _mesh_arrays(obj)
+        positions, corners, sizes, material_index, uvs = _mesh_arrays(obj)
         if len(sizes) == 0:
             continue
         world = geometry.transform_points(positions, matrix)
-        if np.linalg.det(matrix[:3, :3]) < 0:
+        mirrored = np.linalg.det(matrix[:3, :3]) < 0
+        if mirrored:
             # A mirroring transform flips the winding; keep normals as Blender shows them.
             corners = geometry.reverse_polygons(corners, sizes)
         materials = [slot.material for slot in obj.material_slots] or [None]
@@ -292,10 +320,14 @@ def export_scene(context, blender_version=None):
         slot = np.clip(material_index, 0, len(materials) - 1)
         builder.add(world, corners, sizes, rho_table[slot], emit_table[slot], True)
         name = original.name if not inst.is_instance else "%s (%s)" % (original.name, owner.name)
-        parts.append(Part(name=_unique(names_used, name), source=owner.name,
-                          is_instance=inst.is_instance, is_light=False, face_count=len(sizes),
-                          corner_points=world[corners], face_sizes=sizes,
-                          materials=materials, material_index=slot))
+        part = Part(name=_unique(names_used, name), source=owner.name,
+                    is_instance=inst.is_instance, is_light=False, face_count=len(sizes),
+                    corner_points=world[corners], face_sizes=sizes,
+                    materials=materials, material_index=slot)
+        if uvs is not None:
+            part.uv_layers, part.triangles, part.triangle_face = uvs.corners(mirrored)
+            part.uv_render = uvs.render
+        parts.append(part)
         hidden_sources.add(owner.name)
 
     unmodelled = []

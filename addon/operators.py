@@ -267,13 +267,15 @@ class RADIOSITY_OT_solve(Operator):
         skipped_objects = []
         warnings = []
         convert = material = None
-        if settings.display_colours:
+        # Lighting Only keeps the user's materials, which no unlit material can
+        # stand in for: game-ready colours apply to the other outputs.
+        if settings.display_colours and mode != 'LIGHTING':
             convert, material, note = game_export.bake_options(scene)
             if note:
                 warnings.append(note)
-        if mode in {'REFINED', 'BOTH'}:
+        if mode in {'REFINED', 'BOTH', 'LIGHTING'}:
             bake.write_refined(scene, job.exported, result, settings.show_wireframe,
-                               convert=convert, material=material)
+                               convert=convert, material=material, lighting=mode == 'LIGHTING')
             bake.hide_originals(scene, context.view_layer, job.exported.hidden_sources)
             bake.show_results(scene, True)
         else:

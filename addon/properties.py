@@ -46,6 +46,10 @@ OUTPUT_ITEMS = (
      "without refinement"),
     ('BOTH', "Both",
      "Write refined meshes and the attribute on the original meshes"),
+    ('LIGHTING', "Lighting Only (Keep Materials)",
+     "Write refined meshes like Refined Meshes, each with copies of its original's "
+     "materials (textures included) lit by the solution's 'Radiosity Light' attribute "
+     "(the light before the surface's colour); the originals are untouched"),
 )
 
 
@@ -201,7 +205,7 @@ class RadiositySettings(PropertyGroup):
             "Bake display-ready colours for game engines instead of radiance: exposure, "
             "the scene's view transform (Color Management) and a clamp to 0-1, shown "
             "through an unlit material that the glTF exporter writes as KHR_materials_unlit "
-            "with the colours as COLOR_0"
+            "with the colours as COLOR_0 (not with Lighting Only, which keeps the materials)"
         ),
         default=False,
     )

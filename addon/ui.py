@@ -48,6 +48,7 @@ class RENDER_PT_radiosity(Panel):
         col.prop(settings, "show_wireframe")
 
         col = layout.column(heading="Game Export")
+        col.active = settings.output != 'LIGHTING'  # it keeps the materials: nothing to make unlit
         col.prop(settings, "display_colours")
         sub = col.column()
         sub.active = settings.display_colours
