@@ -236,7 +236,45 @@ class PanelTest(unittest.TestCase):
             layout.use_property_splitt = True
 
 
+class UnlitFactoryScene:
+    """The factory scene (a cube, a point light, a grey world) with no light the
+    solver models: the point light unlinked and the world's Background fed by a
+    texture (only a uniform colour is modelled). Undone on exit, so every test
+    sees the factory scene it started with and nothing here is ever solved."""
+
+    def __enter__(self):
+        scene = bpy.context.scene
+        self.light = bpy.data.objects["Light"]
+        self.collections = list(self.light.users_collection)
+        for collection in self.collections:
+            collection.objects.unlink(self.light)
+        self.world = scene.world
+        textured = bpy.data.worlds.new("Textured World")
+        textured.use_nodes = True
+        nodes = textured.node_tree.nodes
+        background = next(n for n in nodes if n.type == 'BACKGROUND')
+        noise = nodes.new("ShaderNodeTexNoise")
+        textured.node_tree.links.new(noise.outputs["Color"], background.inputs["Color"])
+        scene.world = textured
+        return scene
+
+    def __exit__(self, *exc):
+        scene = bpy.context.scene
+        textured, scene.world = scene.world, self.world
+        bpy.data.worlds.remove(textured)
+        for collection in self.collections:
+            collection.objects.link(self.light)
+        return False
+
+
 class OperatorTest(unittest.TestCase):
+    def setUp(self):
+        self.unlit = UnlitFactoryScene()
+        self.unlit.__enter__()
+
+    def tearDown(self):
+        self.unlit.__exit__(None, None, None)
+
     def solve_error(self, *args):
         """Run the operator; return the message Blender raises for its ERROR report."""
         with self.assertRaises(RuntimeError) as caught:
@@ -260,16 +298,17 @@ class OperatorTest(unittest.TestCase):
             bpy.ops.object.mode_set(mode='OBJECT')
 
     def test_reports_no_light_and_changes_nothing(self):
-        # The factory scene has a cube and a point light, which has no area:
-        # nothing emits. Blender turns an ERROR report of a cancelled operator
-        # into RuntimeError for Python callers; the return value {'CANCELLED'}
-        # is checked below.
+        # Nothing emits, no light, and the textured world is not modelled.
+        # Blender turns an ERROR report of a cancelled operator into
+        # RuntimeError for Python callers; the return value {'CANCELLED'} is
+        # checked below.
         scene = bpy.context.scene
         before = scene_snapshot(scene)
         for context in ('EXEC_DEFAULT', 'INVOKE_DEFAULT'):
             message = self.solve_error(context)
             self.assertIn("No light to solve", message)
-            self.assertIn("Not modelled: 1 point light", message)
+            # Says why the world does not count.
+            self.assertIn("Not modelled: world Textured World (only a uniform Background colour", message)
             self.assertEqual(scene_snapshot(scene), before)
 
     def test_returns_cancelled(self):
