@@ -17,8 +17,10 @@ What is exported, as a Cycles render would see it:
 - point, spot and sun lights as the solver's direct lights, and a uniform world
   colour (Background colour x strength) as the world's radiance, each with
   Blender's conventions measured in Cycles (light_units.py).
-What is not modelled (node setups other than the above, textured worlds) is
-collected in `ExportedScene.unmodelled` for one warning.
+What is not modelled (node setups other than the above, light node setups,
+textured worlds) or only approximated (a Principled BSDF's metallic or
+transmission read as diffuse, an emission texture's average) is collected in
+`ExportedScene.unmodelled` for one warning.
 """
 
 import math
@@ -80,6 +82,11 @@ class MaterialReader:
         self._cache = {}
         self._images = {}
         self.unknown = set()
+        # What was read but only approximated: reason -> material names.
+        self.approximated = {}
+
+    def _approximate(self, material, reason):
+        self.approximated.setdefault(reason, set()).add(material.name)
 
     def read(self, material):
         """(reflectance rgb, emission rgb) of `material` (None: default surface)."""
@@ -111,16 +118,21 @@ class MaterialReader:
         kind = node.type
         if kind == 'BSDF_PRINCIPLED':
             rho = self._colour(node.inputs["Base Color"], material)
-            emission = self._colour(compat.principled_emission(node), material)
+            emission = self._emission_colour(compat.principled_emission(node), material)
             strength = _scalar(node.inputs.get("Emission Strength"), 1.0)
             if rho is None or emission is None or strength is None:
                 return None
+            # Cycles renders these lobes; the solver sees the surface as diffuse.
+            for name in ("Metallic", "Transmission Weight", "Transmission"):
+                socket = node.inputs.get(name)
+                if socket is not None and (socket.is_linked or socket.default_value > 0.0):
+                    self._approximate(material, "%s read as diffuse" % name.split()[0].lower())
             return rho, emission * strength
         if kind == 'BSDF_DIFFUSE':
             rho = self._colour(node.inputs["Color"], material)
             return None if rho is None else (rho, np.zeros(3))
         if kind == 'EMISSION':
-            colour = self._colour(node.inputs["Color"], material)
+            colour = self._emission_colour(node.inputs["Color"], material)
             strength = _scalar(node.inputs["Strength"], 1.0)
             if colour is None or strength is None:
                 return None
@@ -150,6 +162,14 @@ class MaterialReader:
         if node.type == 'TEX_IMAGE' and node.image is not None:
             return self._image_average(node.image)
         return None
+
+    def _emission_colour(self, socket, material):
+        """An emission colour: as _colour, and an image feeding it is named, since
+        its average (not the pattern) is what emits."""
+        node = _linked_node(socket) if socket.is_linked else None
+        if node is not None and node.type == 'TEX_IMAGE':
+            self._approximate(material, "emission texture averaged")
+        return self._colour(socket, material)
 
     def _image_average(self, image):
         key = image.name_full
@@ -337,6 +357,9 @@ def export_scene(context, blender_version=None):
     if reader.unknown:
         unmodelled.append("material%s %s (unknown node setup: viewport colour used)"
                           % ("s" if len(reader.unknown) > 1 else "", ", ".join(sorted(reader.unknown))))
+    for reason in sorted(reader.approximated):
+        names = sorted(reader.approximated[reason])
+        unmodelled.append("material%s %s (%s)" % ("s" if len(names) > 1 else "", ", ".join(names), reason))
     unmodelled.extend(sorted(light_notes))
     world, world_note = world_radiance(context.scene.world)
     if world_note:

@@ -123,7 +123,8 @@ def add_mesh(scene, name, geometry, material, location=(0, 0, 0), rotation=(0, 0
 
 # Principled BSDF inputs that Principled v2 (Blender 4.0) renamed: 3.x name -> 4.x name.
 # Both "Specular" and "Specular IOR Level" at 0 mean no specular layer.
-PRINCIPLED_V2_NAMES = {"Specular": "Specular IOR Level", "Emission": "Emission Color"}
+PRINCIPLED_V2_NAMES = {"Specular": "Specular IOR Level", "Emission": "Emission Color",
+                       "Transmission": "Transmission Weight"}
 
 
 def principled_input(node, name):

@@ -129,7 +129,41 @@ class MaterialTest(unittest.TestCase):
             return n
 
         plane(scene, "T", node_material("T", textured))
-        np.testing.assert_allclose(face_rows(export_now(), "T")["reflectance"], [[0.4, 0.0, 0.2]], atol=1e-6)
+        ex = export_now()
+        np.testing.assert_allclose(face_rows(ex, "T")["reflectance"], [[0.4, 0.0, 0.2]], atol=1e-6)
+        self.assertEqual(ex.unmodelled, [])   # a base colour texture is modelled (and kept: Lighting Only)
+
+    def test_approximations_are_named(self):
+        # Read as diffuse or averaged, and said so in the warning.
+        scene = new_file()
+        image = bpy.data.images.new("Screen", 2, 2, alpha=False, float_buffer=True)
+        image.pixels.foreach_set(np.tile([2.0, 1.0, 0.5, 1.0], 4).astype(np.float32))
+
+        def principled_with(name, value):
+            def build(tree):
+                n = tree.nodes.new("ShaderNodeBsdfPrincipled")
+                n.inputs["Base Color"].default_value = (0.5, 0.5, 0.5, 1)
+                kit.principled_input(n, name).default_value = value
+                return n
+            return build
+
+        def screen(tree):
+            n = tree.nodes.new("ShaderNodeEmission")
+            tex = tree.nodes.new("ShaderNodeTexImage")
+            tex.image = image
+            tree.links.new(tex.outputs["Color"], n.inputs["Color"])
+            return n
+
+        plane(scene, "Metal", node_material("Metal", principled_with("Metallic", 1.0)))
+        plane(scene, "Glass", node_material("Glass", principled_with("Transmission", 1.0)))
+        plane(scene, "Screen", node_material("Screen", screen))
+        ex = export_now()
+        np.testing.assert_allclose(face_rows(ex, "Metal")["reflectance"], [[0.5, 0.5, 0.5]], rtol=1e-6)
+        np.testing.assert_allclose(face_rows(ex, "Screen")["emission"], [[2.0, 1.0, 0.5]], rtol=1e-6)
+        message = export.unmodelled_message(ex.unmodelled)
+        self.assertIn("material Metal (metallic read as diffuse)", message)
+        self.assertIn("material Glass (transmission read as diffuse)", message)
+        self.assertIn("material Screen (emission texture averaged)", message)
 
 
 class GeometryTest(unittest.TestCase):
@@ -189,6 +223,7 @@ class LightTest(unittest.TestCase):
             scene.collection.objects.link(obj)
         for kind in ('POINT', 'SPOT', 'SUN', 'POINT'):
             scene.collection.objects.link(bpy.data.objects.new(kind, bpy.data.lights.new(kind, kind)))
+        bpy.data.lights["POINT"].use_nodes = True   # light node setups (IES too) are not modelled
         ex = export_now()
         self.assertEqual(sorted(p.name for p in ex.parts), ["Disk", "Ellipse", "Rect"])
         a = ex.arrays
@@ -200,10 +235,9 @@ class LightTest(unittest.TestCase):
             normal = geometry.polygon_normals(a["positions"], a["face_vertices"][
                 np.repeat(a["face_part"], a["face_sizes"]) == i], a["face_sizes"][rows])
             np.testing.assert_allclose(normal, [[0, 1, 0]], atol=1e-6)   # -z turned to +y (float32 matrix)
-        message = export.unmodelled_message(ex.unmodelled)
-        self.assertIn("2 point lights", message)
-        self.assertIn("1 spot light", message)
-        self.assertIn("1 sun light", message)
+        # Point, spot and sun lights are the solver's direct lights, not polygons.
+        self.assertEqual(sorted(light["type"] for light in ex.lights), ["point", "point", "spot", "sun"])
+        self.assertEqual(export.unmodelled_message(ex.unmodelled), "Not modelled: light node setups")
 
 
 if __name__ == "__main__":
