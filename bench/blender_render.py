@@ -42,7 +42,7 @@ EDGE_PIECES = 5
 def load_result(path):
     d = np.load(path)
     return SimpleNamespace(**{k: d[k] for k in ("positions", "face_vertices", "face_sizes", "radiance",
-                                                "source_face", "source_side")})
+                                                "vertex_irradiance", "source_face", "source_side")})
 
 
 def visible_edges(scene, result, projection):

@@ -30,7 +30,8 @@ def load_scene(rad, npz_path):
 
 def save_result(result, path):
     np.savez(path, positions=result.positions, face_vertices=result.face_vertices, face_sizes=result.face_sizes,
-             radiance=result.radiance, source_face=result.source_face, source_side=result.source_side)
+             radiance=result.radiance, vertex_irradiance=result.vertex_irradiance, source_face=result.source_face,
+             source_side=result.source_side)
 
 
 def solve_point(rad, scene, oracle, quality, repeats=1, repeat_below=0.0):
