@@ -28,6 +28,7 @@ from . import bake, export, game_export, native
 STATUS = {
     "quality": "Converged",
     "max_elements": "Element budget reached",
+    "memory": "Memory limit reached (refinement stopped there)",
     "time_budget": "Time budget reached",
     "cancel": "Cancelled (last complete pass kept)",
 }
@@ -35,6 +36,11 @@ STATUS = {
 
 class SolveError(Exception):
     """A failure the user can act on; its message is reported as is."""
+
+
+# What the native module raises for input it refuses (ValueError) or a scene
+# too large for memory (MemoryError): the user can act on both.
+REFUSALS = (ValueError, MemoryError)
 
 
 @dataclass
@@ -208,7 +214,7 @@ class RADIOSITY_OT_solve(Operator):
                     print(progress_text(p), flush=True)
         try:
             job.result = solver.solve(job.native_scene, progress=progress, **job.options)
-        except ValueError as err:
+        except REFUSALS as err:
             raise SolveError("Radiosity: %s" % err) from None
         return self._conclude(context, job)
 
@@ -243,7 +249,7 @@ class RADIOSITY_OT_solve(Operator):
         """Report a finished job's error, or bake its result (main thread)."""
         try:
             if job.error is not None:
-                if isinstance(job.error, ValueError):
+                if isinstance(job.error, REFUSALS):
                     raise SolveError("Radiosity: %s" % job.error)
                 raise job.error
             return self._finish(context, job)

@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <atomic>
 #include <cmath>
 #include <numbers>
 
@@ -20,6 +21,23 @@ bool all_facing(const ClusterNode& node, const dvec3& w, double cone) {
 bool none_facing(const ClusterNode& node, const dvec3& w, double cone) {
   const double angle = std::acos(std::clamp(glm::dot(node.axis, w), -1.0, 1.0));
   return angle - node.spread - cone > 0.5 * std::numbers::pi + 1e-6;
+}
+
+// Two flat nodes (every side facing along its axis) that cannot exchange
+// light: facing the same way (each side sees only what rises above its own
+// plane, and the other must see it back), or facing opposite ways with no
+// side of the emitter above a side of the receiver (the two halves of a
+// two-sided floor). Exact pruning: the walk would reach the same verdict at
+// every pair of leaves, n^2 pairs over a tiled floor.
+bool flat_pair_apart(const ClusterNode& rx, const ClusterNode& ry) {
+  if (!rx.is_flat() || !ry.is_flat()) return false;
+  const double c = glm::dot(rx.axis, ry.axis);
+  const double parallel = std::cos(2.0 * ClusterNode::kFlatSpread);
+  if (c > parallel) return true;
+  if (c >= -parallel) return false;
+  // Heights along rx's axis: the emitter's highest is -ry.height_lo.
+  const double tolerance = 1e-9 * (rx.radius + ry.radius);
+  return -ry.height_lo <= rx.height_lo + tolerance;
 }
 
 // A point uniformly distributed over the node's sides (area-weighted).
@@ -76,6 +94,7 @@ PairOutcome classify(const ClusterTree& tree, const Hierarchy& hierarchy, const 
     return out;
   };
   if (x == y) return rx.is_leaf() ? out : split(PairOutcome::SplitBoth);
+  if (flat_pair_apart(rx, ry)) return out;
   const bool both_leaves = rx.is_leaf() && ry.is_leaf();
   const dvec3 between = rx.centre - ry.centre;
   const double d = glm::length(between);
@@ -170,8 +189,16 @@ InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy, 
   // each pair's subtree depth first (memory stays that of one path per
   // thread), each into its own lists, joined in pair order: the links do not
   // depend on the thread count.
+  // Cancellation (and the time budget) is checked every kCheckEvery pairs a
+  // thread classifies: one pair's subtree can hold millions of pairs.
+  constexpr int kCheckEvery = 4096;
+  std::atomic<bool> stop{false};
+  const auto should_stop = [&] {
+    if (!stop.load(std::memory_order_relaxed) && cancelled && cancelled()) stop = true;
+    return stop.load(std::memory_order_relaxed);
+  };
   std::vector<Pair> frontier{{tree.root(), tree.root()}};
-  while (!frontier.empty() && frontier.size() < 4096) {
+  while (!frontier.empty() && frontier.size() < 4096 && !should_stop()) {
     std::vector<Pair> next;
     for (const Pair& p : frontier) {
       const PairOutcome o = classify_pair(p);
@@ -184,13 +211,18 @@ InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy, 
   }
   std::vector<InitialLinks> found(frontier.size());
   const size_t chunk = 256;  // pairs between cancellation checks
-  for (size_t begin = 0; begin < frontier.size() && !(cancelled && cancelled()); begin += chunk) {
+  for (size_t begin = 0; begin < frontier.size() && !should_stop(); begin += chunk) {
     const size_t end = std::min(frontier.size(), begin + chunk);
     tbb::parallel_for(tbb::blocked_range<size_t>(begin, end, 1), [&](const auto& range) {
       std::vector<Pair> stack;
+      int since_check = 0;
       for (size_t i = range.begin(); i != range.end(); ++i) {
         stack.assign(1, frontier[i]);
         while (!stack.empty()) {
+          if (++since_check == kCheckEvery) {
+            since_check = 0;
+            if (should_stop()) return;
+          }
           const Pair p = stack.back();
           stack.pop_back();
           const PairOutcome o = classify_pair(p);

@@ -44,7 +44,8 @@ struct InitialLinks {
 };
 
 // The walk described above; `separation` > 1, `rays` shadow rays per cluster
-// link. Returns early (incomplete) once `cancelled` says so; `progress`, if
+// link. Returns early (incomplete) once `cancelled` (called from worker
+// threads, so it must be thread-safe) says so; `progress`, if
 // set, hears the fraction of the walk done (from the walking thread).
 InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy, const RayScene& scene,
                            double separation, int rays, const std::function<bool()>& cancelled,

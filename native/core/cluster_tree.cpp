@@ -71,6 +71,16 @@ std::int32_t ClusterTree::build(const Hierarchy& hierarchy, std::uint32_t first,
     const double c = std::clamp(glm::dot(node.axis, hierarchy.normal(hierarchy.element(*it))), -1.0, 1.0);
     node.spread = std::max(node.spread, std::acos(c));
   }
+  node.height_lo = std::numeric_limits<double>::infinity();
+  node.height_hi = -node.height_lo;
+  for (auto it = begin; it != end; ++it) {
+    dvec3 corners[4];
+    const int n = hierarchy.corners(hierarchy.element(*it), corners);
+    for (int k = 0; k < n; ++k) {
+      node.height_lo = std::min(node.height_lo, glm::dot(node.axis, corners[k]));
+      node.height_hi = std::max(node.height_hi, glm::dot(node.axis, corners[k]));
+    }
+  }
 
   if (count > 1) {
     // Facing classes first (sides in one class face within 55 degrees of an

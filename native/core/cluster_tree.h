@@ -18,6 +18,12 @@ struct ClusterNode {
   double radius = 0.0;      // of the sphere about `centre` holding every side
   dvec3 axis{0.0};          // of the normals' cone (area-weighted mean normal)
   double spread = 0.0;      // the cone's half-angle, radians
+  // Heights of its sides' corners along `axis`: where every side faces along
+  // the axis (is_flat: a floor, a tiled wall), a side sees only what rises
+  // above its own plane (cluster_links.cpp prunes coplanar pairs with this).
+  double height_lo = 0.0, height_hi = 0.0;
+  bool is_flat() const { return spread < kFlatSpread; }
+  static constexpr double kFlatSpread = 1e-6;  // radians
   double area = 0.0;
   std::int32_t child[2] = {kNone, kNone};
   std::uint32_t first = 0, count = 0;  // its sides: ClusterTree::sides()[first, first + count)

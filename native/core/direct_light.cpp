@@ -4,10 +4,12 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
 #include "core/form_factor.h"
+#include "core/scene.h"
 #include "core/sampled_visibility.h"
 #include "core/shaft.h"
 #include "core/visible_polygon.h"
@@ -105,13 +107,23 @@ std::optional<LightKind> parse_light_kind(std::string_view name) {
   return std::nullopt;
 }
 
+namespace {
+std::string to_text(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+}  // namespace
+
 void check_light(const Light& light, std::size_t index) {
   const std::string which = "light " + std::to_string(index) + ": ";
   const auto finite = [](const dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
   for (int c = 0; c < 3; ++c)
-    if (!(std::isfinite(light.colour[c]) && light.colour[c] >= 0.0))
-      throw std::invalid_argument(which + "its colour (intensity) must be finite and >= 0");
-  if (!finite(light.position)) throw std::invalid_argument(which + "its position must be finite");
+    if (!(light.colour[c] >= 0.0 && light.colour[c] <= kMaxInputRadiance))
+      throw std::invalid_argument(which + "its colour (intensity) must lie in [0, " + to_text(kMaxInputRadiance) + "]");
+  if (!(finite(light.position) && glm::length(light.position) <= kMaxCoordinate))
+    throw std::invalid_argument(which + "its position must be finite and within " + to_text(kMaxCoordinate) +
+                                " of the origin");
   if (!finite(light.direction) || !(glm::length(light.direction) > 0.0))
     throw std::invalid_argument(which + "its direction must be finite and not zero");
   if (!(std::isfinite(light.radius) && light.radius >= 0.0))

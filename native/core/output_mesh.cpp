@@ -1,7 +1,10 @@
 #include "core/output_mesh.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
+#include <stdexcept>
+#include <string>
 #include <unordered_map>
 
 #include <glm/gtc/type_precision.hpp>
@@ -259,6 +262,32 @@ OutputMesh make_output_mesh(const Hierarchy& h,
                                                    static_cast<float>(mean.z)});
   }
   return mesh;
+}
+
+void require_finite(const OutputMesh& mesh) {
+  const auto finite = [](const auto& values, size_t first, size_t count) {
+    for (size_t i = first; i < first + count; ++i)
+      if (!std::isfinite(values[i])) return false;
+    return true;
+  };
+  size_t corner = 0;
+  for (size_t p = 0; p < mesh.polygon_count(); ++p) {
+    const char* what = finite(mesh.irradiance, 3 * p, 3) ? nullptr : "irradiance";
+    const auto size = static_cast<size_t>(mesh.face_sizes[p]);
+    for (size_t k = 0; k < size && !what; ++k) {
+      const auto v = static_cast<size_t>(mesh.face_vertices[corner + k]);
+      if (!finite(mesh.positions, 3 * v, 3)) what = "position";
+      else if (!finite(mesh.radiance, 3 * v, 3)) what = "radiance";
+      else if (!finite(mesh.vertex_irradiance, 3 * v, 3)) what = "vertex irradiance";
+    }
+    corner += size;
+    if (what) {
+      throw std::runtime_error(std::string("the solve produced a non-finite ") + what + " on input face " +
+                               std::to_string(mesh.source_face[p]) + " (" + (mesh.source_side[p] ? "back" : "front") +
+                               " side, output polygon " + std::to_string(p) +
+                               "); this is a bug in the solver: nothing was written");
+    }
+  }
 }
 
 }  // namespace radiosity

@@ -37,4 +37,10 @@ struct OutputMesh {
 OutputMesh make_output_mesh(const Hierarchy& hierarchy,
                             const std::vector<std::array<Rgb, kMaxSamples>>& leaf_irradiance);
 
+// The guarantee at the boundary: throws std::runtime_error naming the polygon,
+// its input face and side if any position, radiance or irradiance is NaN or
+// infinite. Input is range-checked (scene.h), so such a value is a solver bug;
+// it must reach the caller as an error, never as a mesh.
+void require_finite(const OutputMesh& mesh);
+
 }  // namespace radiosity

@@ -147,15 +147,20 @@ void check_sizes(const SceneArrays& a) {
   if (!a.occludes.empty() && a.occludes.size() != faces) {
     fail("occludes must have one entry per face (" + std::to_string(faces) + ")");
   }
-  std::int64_t total = 0;
+  // Summed in size_t with each term bounded, so sizes cannot wrap around.
+  size_t total = 0;
   for (size_t f = 0; f < faces; ++f) {
-    if (a.face_sizes[f] < 3) {
-      fail("face_sizes[" + std::to_string(f) + "] = " + std::to_string(a.face_sizes[f]) +
-           ": a face needs at least 3 vertices");
+    const std::int64_t size = a.face_sizes[f];
+    if (size < 3) {
+      fail("face_sizes[" + std::to_string(f) + "] = " + std::to_string(size) + ": a face needs at least 3 vertices");
     }
-    total += a.face_sizes[f];
+    if (static_cast<std::uint64_t>(size) > a.face_vertices.size() - total) {
+      fail("face_sizes adds up to more than the " + std::to_string(a.face_vertices.size()) +
+           " entries of face_vertices (at face " + std::to_string(f) + ")");
+    }
+    total += static_cast<size_t>(size);
   }
-  if (static_cast<size_t>(total) != a.face_vertices.size()) {
+  if (total != a.face_vertices.size()) {
     fail("face_vertices has " + std::to_string(a.face_vertices.size()) +
          " entries but face_sizes adds up to " + std::to_string(total));
   }
@@ -166,6 +171,12 @@ void check_values(const SceneArrays& a) {
   for (size_t i = 0; i < a.positions.size(); ++i) {
     if (!std::isfinite(a.positions[i])) {
       fail("positions contains a non-finite value at vertex " + std::to_string(i / 3));
+    }
+    if (std::abs(a.positions[i]) > kMaxCoordinate) {
+      std::ostringstream m;
+      m << "vertex " << i / 3 << " lies " << std::abs(a.positions[i]) << " from the origin; coordinates beyond "
+        << kMaxCoordinate << " cannot be solved (scale the scene down)";
+      fail(m.str());
     }
   }
   for (size_t i = 0; i < a.face_vertices.size(); ++i) {
@@ -185,9 +196,9 @@ void check_values(const SceneArrays& a) {
   }
   for (size_t i = 0; i < a.emission.size(); ++i) {
     const double e = a.emission[i];
-    if (!std::isfinite(e) || e < 0.0) {
+    if (!std::isfinite(e) || e < 0.0 || e > kMaxInputRadiance) {
       std::ostringstream m;
-      m << "emission of face " << i / 3 << " is " << e << "; it must be finite and >= 0";
+      m << "emission of face " << i / 3 << " is " << e << "; it must lie in [0, " << kMaxInputRadiance << "]";
       fail(m.str());
     }
   }
@@ -211,6 +222,12 @@ Scene make_scene(const SceneArrays& a) {
     hi = glm::max(hi, vertex(static_cast<std::int64_t>(v)));
   }
   scene.diameter = glm::length(hi - lo);
+  if (!(scene.diameter >= kMinSceneSize)) {
+    std::ostringstream m;
+    m << "the scene is " << scene.diameter << " across; scenes smaller than " << kMinSceneSize
+      << " cannot be solved (scale the scene up)";
+    fail(m.str());
+  }
 
   size_t offset = 0;
   std::vector<dvec3> polygon;
@@ -257,7 +274,11 @@ Scene make_scene(const SceneArrays& a) {
   for (const Light& light : a.lights)
     if (luminance(light.colour) > 0.0) scene.lights.push_back(light);
   for (int c = 0; c < 3; ++c) {
-    if (!(std::isfinite(a.world[c]) && a.world[c] >= 0.0)) fail("the world's radiance must be finite and >= 0");
+    if (!(a.world[c] >= 0.0 && a.world[c] <= kMaxInputRadiance)) {
+      std::ostringstream m;
+      m << "the world's radiance must lie in [0, " << kMaxInputRadiance << "]";
+      fail(m.str());
+    }
   }
   if (luminance(a.world) > 0.0) {
     Light sky;

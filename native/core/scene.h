@@ -16,6 +16,15 @@
 
 namespace radiosity {
 
+// The range of input the solver computes in: radiance (emission, lights, the
+// world) up to kMaxInputRadiance, so that every bounce stays far inside the
+// float32 output (3.4e38); coordinates within kMaxCoordinate and a scene at
+// least kMinSceneSize across (form factors square and cube distances in
+// double precision). Larger or smaller input is refused before any work.
+inline constexpr double kMaxInputRadiance = 1e30;
+inline constexpr double kMaxCoordinate = 1e30;
+inline constexpr double kMinSceneSize = 1e-30;
+
 // Views on the caller's arrays (numpy, without copies).
 struct SceneArrays {
   std::span<const double> positions;       // 3 per vertex

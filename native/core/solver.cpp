@@ -4,9 +4,13 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <fstream>
+#include <sstream>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -60,6 +64,23 @@ constexpr double kMissedLight = 0.01;
 // Shadow rays that measure a cluster link's visible fraction.
 constexpr int kClusterRays = 16;
 
+// Bytes of memory available now (Linux: MemAvailable), or a large number
+// where it cannot be read.
+std::size_t available_memory() {
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  std::size_t kilobytes = 0;
+  std::string unit;
+  while (meminfo >> key >> kilobytes >> unit) {
+    if (key == "MemAvailable:") return kilobytes * 1024;
+  }
+  const long pages = sysconf(_SC_AVPHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  if (pages > 0 && page > 0) return static_cast<std::size_t>(pages) * static_cast<std::size_t>(page);
+  return std::numeric_limits<std::size_t>::max() / 2;
+}
+
+double gigabytes(std::size_t bytes) { return std::round(static_cast<double>(bytes) / 1e8) / 10.0; }
+
 class Solver {
  public:
   Solver(const Scene& scene, const SolveOptions& options, const ProgressCallback& progress,
@@ -76,6 +97,7 @@ class Solver {
         direct_(hierarchy_, occluders_, options.visibility, options.rays, options.oracle,
                 oracle_geometric_scale(options.oracle, scene.total_area)),
         min_area_(options.min_element_area * scene.total_area),
+        memory_limit_(options.memory_limit.value_or(std::numeric_limits<std::size_t>::max())),
         clusters_(hierarchy_) {}
 
   SolveResult run();
@@ -87,6 +109,9 @@ class Solver {
   }
   double elapsed() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
   bool out_of_time() const { return options_.time_budget && elapsed() > *options_.time_budget; }
+  // Cancelled, or a refinement cut short by the time budget: the pass is
+  // abandoned and the last complete one stands.
+  bool pass_abandoned() const { return cancelled() || refinement_cut_short_; }
 
   void report(const std::string& phase, double fraction);
   void link_initially();
@@ -98,6 +123,7 @@ class Solver {
   void gather_direct_light();
   double adaptation_radiance() const;
   Split choose_split(const Link& link, double threshold) const;
+  bool over_memory() const { return stats_.element_bytes + stats_.link_bytes > memory_limit_; }
   bool can_split(std::int32_t e) const { return hierarchy_.element(e).area / 4.0 >= min_area_; }
   bool near_field(const Link& link, bool receiver_end) const;
   void group_links();
@@ -111,7 +137,7 @@ class Solver {
   const SolveOptions options_;
   const ProgressCallback& progress_;
   const CancelCheck& cancel_;
-  mutable bool stopped_ = false;
+  mutable std::atomic<bool> stopped_{false};  // read and set from worker threads
   const Clock::time_point start_;
   Hierarchy hierarchy_;
   SceneOccluders occluders_;
@@ -120,6 +146,7 @@ class Solver {
   // Brightness the oracles' thresholds are relative to (refine()).
   double reference_radiance_ = 0.0;
   const double min_area_;
+  const std::size_t memory_limit_;  // bytes of elements and links (SolveOptions::memory_limit)
   std::vector<Link> links_;
   // Links grouped by receiver for the gather, and which links they describe.
   std::vector<std::uint32_t> offset_, order_;
@@ -136,7 +163,10 @@ class Solver {
   std::uint64_t light_version_ = 1, direct_version_ = 0;
   std::uint64_t links_version_ = 1, grouped_version_ = 0;
   SolveResult result_;  // the last complete pass
-  bool budget_hit_ = false;
+  bool budget_hit_ = false;  // max_elements or memory_limit reached
+  bool memory_hit_ = false;
+  bool cut_short_ = false;             // the last evaluate_links stopped before the end
+  bool refinement_cut_short_ = false;  // ... within refine(): the pass is abandoned
   int pass_ = 0, passes_ = 1;
   double threshold_ = std::numeric_limits<double>::infinity();
   SolveStats stats_;
@@ -206,7 +236,7 @@ std::vector<Link> Solver::evaluate_links(std::vector<Link>&& candidates) {
   tbb::enumerable_thread_specific<LinkTimings> timings;
   // Chunks keep cancellation prompt without a check per link.
   const size_t chunk = 1024;
-  for (size_t begin = 0; begin < groups && !cancelled(); begin += chunk) {
+  for (size_t begin = 0; begin < groups && !cancelled() && !out_of_time(); begin += chunk) {
     const size_t end = std::min(groups, begin + chunk);
     tbb::parallel_for(tbb::blocked_range<size_t>(begin, end), [&](const auto& range) {
       LinkTimings& local = timings.local();
@@ -225,6 +255,7 @@ std::vector<Link> Solver::evaluate_links(std::vector<Link>&& candidates) {
     });
   }
   for (const LinkTimings& t : timings) stats_.link_cpu += t;
+  cut_short_ = groups > 0 && (cancelled() || out_of_time());
   size_t kept = 0;
   for (size_t i = 0; i < candidates.size(); ++i) {
     if (visible[i]) candidates[kept++] = candidates[i];
@@ -259,13 +290,13 @@ void Solver::link_initially() {
   const auto start = Clock::now();
   // Progress: the walk is the first half of linking, evaluating face links the second.
   InitialLinks initial = link_clusters(clusters_, hierarchy_, *occluders_.rays, cluster_separation(options_),
-                                       kClusterRays, [this] { return cancelled(); },
+                                       kClusterRays, [this] { return cancelled() || out_of_time(); },
                                        [this](double done) { report("linking", 0.05 * done); });
   stats_.seconds_clustering = std::chrono::duration<double>(Clock::now() - start).count();
   // In blocks, so cancellation and progress stay prompt for large scenes.
   const size_t block = 65536;
   std::vector<Link>& candidates = initial.elements;
-  for (size_t begin = 0; begin < candidates.size() && !cancelled(); begin += block) {
+  for (size_t begin = 0; begin < candidates.size() && !cancelled() && !out_of_time(); begin += block) {
     const size_t end = std::min(candidates.size(), begin + block);
     std::vector<Link> visible = evaluate_links(std::vector<Link>(candidates.begin() + static_cast<std::ptrdiff_t>(begin),
                                                                  candidates.begin() + static_cast<std::ptrdiff_t>(end)));
@@ -382,6 +413,10 @@ bool Solver::refine(double threshold) {
   reference_radiance_ = adaptation_radiance();
   bool changed = false;
   while (!cancelled() && !budget_hit_ && !out_of_time()) {
+    if (over_memory()) {
+      budget_hit_ = memory_hit_ = true;
+      break;
+    }
     std::vector<Split> decision(links_.size(), Split::None);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, links_.size()), [&](const auto& range) {
       for (size_t i = range.begin(); i != range.end(); ++i) decision[i] = choose_split(links_[i], threshold);
@@ -454,7 +489,10 @@ bool Solver::refine(double threshold) {
     }
     changed = true;
     std::vector<Link> made = evaluate_links(std::move(fresh));
-    if (cancelled()) break;  // a partial evaluation is discarded with the pass
+    if (cut_short_) {  // a partial evaluation is discarded with the pass
+      refinement_cut_short_ = true;
+      break;
+    }
     for (const Link& l : made) hierarchy_.element(l.receiver).has_links = 1;
     kept.insert(kept.end(), made.begin(), made.end());
     links_ = std::move(kept);
@@ -591,13 +629,13 @@ double Solver::iterate(double threshold, int max_iterations, double tolerance) {
   // high-albedo scene iterates hundreds of times without new refinement).
   double drift = std::numeric_limits<double>::infinity();
   TailExtrapolation tail;
-  for (int i = 0; i < max_iterations && !cancelled(); ++i) {
+  for (int i = 0; i < max_iterations && !pass_abandoned(); ++i) {
     bool refined = false;
     if (drift > 1e-3) {
       refined = refine(threshold);
       drift = refined ? std::numeric_limits<double>::infinity() : 0.0;
     }
-    if (cancelled()) break;
+    if (pass_abandoned()) break;
     const auto start = Clock::now();
     tail.before(hierarchy_);
     residual = gather_push_pull();
@@ -609,7 +647,8 @@ double Solver::iterate(double threshold, int max_iterations, double tolerance) {
     if (extrapolated) continue;  // not converged until an iteration confirms it
     // A pass cut short by the element budget is the last: converge it fully.
     if (!refined && residual < (budget_hit_ ? options_.tolerance : tolerance)) break;
-    if (out_of_time() && !refined && i > 0 && residual < 1e3 * tolerance) break;
+    // The budget ends the pass once an iteration has gathered (from the last refinement, if any).
+    if (out_of_time()) break;
   }
   return residual;
 }
@@ -661,12 +700,12 @@ SolveResult Solver::run() {
     } else {
       iterate(threshold_, options_.max_iterations, last ? options_.tolerance : 1e-3);
     }
-    if (cancelled()) break;
+    if (pass_abandoned()) break;
     snapshot(threshold_);
     stats_.passes = pass_ + 1;
     report("pass", (pass_ + 1.0) / passes_);
     if (budget_hit_) {
-      stats_.stopped_by = "max_elements";
+      stats_.stopped_by = memory_hit_ ? "memory" : "max_elements";
       break;
     }
     if (out_of_time()) {
@@ -674,6 +713,7 @@ SolveResult Solver::run() {
       break;
     }
   }
+  if (refinement_cut_short_) stats_.stopped_by = "time_budget";
   if (cancelled()) {
     stats_.cancelled = true;
     stats_.stopped_by = "cancel";
@@ -695,6 +735,14 @@ SolveResult Solver::run() {
 
 }  // namespace
 
+std::size_t estimated_base_bytes(const Scene& scene) {
+  // Per patch: two sides' elements with their gather state, the cluster tree
+  // (about two nodes per side), and Embree's BVH (about 128 bytes a primitive).
+  constexpr std::size_t kPerSide = sizeof(Element) + 2 * sizeof(ClusterNode) + 4 * sizeof(Rgb);
+  constexpr std::size_t kPerPatch = sizeof(Patch) + 2 * kPerSide + 128;
+  return scene.patches.size() * kPerPatch;
+}
+
 double quality_threshold(Oracle oracle, double quality) {
   if (!(quality > 0.0)) return std::numeric_limits<double>::infinity();
   const ThresholdRange range = threshold_range(oracle);
@@ -715,12 +763,25 @@ SolveResult solve(const Scene& scene, const SolveOptions& options, const Progres
   }
   if (options.rays < 1 || options.rays > 65536) throw std::invalid_argument("rays must lie in [1, 65536]");
   if (options.bounces && *options.bounces < 1) throw std::invalid_argument("bounces must be at least 1");
-  if (options.threads && *options.threads < 1) throw std::invalid_argument("threads must be at least 1");
+  if (options.threads && (*options.threads < 1 || *options.threads > kMaxThreads))
+    throw std::invalid_argument("threads must lie in [1, " + std::to_string(kMaxThreads) + "]");
   if (!(options.min_element_area > 0.0 && options.min_element_area < 1.0)) {
     throw std::invalid_argument("min_element_area must lie in (0, 1)");
   }
+  SolveOptions checked = options;
+  if (!checked.memory_limit) checked.memory_limit = available_memory() / 4 * 3;
+  const std::size_t needed = estimated_base_bytes(scene);
+  if (needed > *checked.memory_limit) {
+    std::ostringstream m;
+    m << "the scene needs about " << gigabytes(needed) << " GB before any refinement, more than the "
+      << gigabytes(*checked.memory_limit) << " GB the solve may use (" << scene.patches.size()
+      << " planar pieces); solve fewer or simpler objects";
+    throw InsufficientMemory(m.str());
+  }
   tbb::task_arena arena(options.threads ? *options.threads : tbb::task_arena::automatic);
-  return arena.execute([&] { return Solver(scene, options, progress, cancel).run(); });
+  SolveResult result = arena.execute([&] { return Solver(scene, checked, progress, cancel).run(); });
+  require_finite(result.mesh);
+  return result;
 }
 
 }  // namespace radiosity

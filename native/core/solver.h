@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "core/link_transport.h"
@@ -18,6 +19,20 @@
 
 namespace radiosity {
 
+// More worker threads than any machine this runs on has cores.
+inline constexpr int kMaxThreads = 1024;
+
+// Thrown before any work when even the unrefined solve would not fit in the
+// memory limit (Python: MemoryError, with this message).
+struct InsufficientMemory : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Bytes an unrefined solve of `scene` needs at least (patches, elements, the
+// cluster tree and the ray-tracing structure): the estimate the memory limit
+// is checked against before allocating.
+std::size_t estimated_base_bytes(const Scene& scene);
+
 struct SolveOptions {
   Oracle oracle = Oracle::Perceptual;
   // 0 = no refinement (the coarsest solution), 1 = the finest the oracle's
@@ -25,12 +40,16 @@ struct SolveOptions {
   double quality = 0.5;
   std::optional<std::size_t> max_elements;  // element budget
   std::optional<double> time_budget;        // seconds
+  // Bytes the elements and links may hold; refinement stops there (stopped_by
+  // "memory"), and a scene whose unrefined solve cannot fit is refused before
+  // any allocation. Default: 3/4 of the memory available when the solve starts.
+  std::optional<std::size_t> memory_limit;
   VisibilityMode visibility = VisibilityMode::Exact;
   int rays = 16;
   // When set: one pass at the target threshold, with exactly this many
   // refine/gather/push-pull iterations from L = L_e (the source's 3-iteration runs).
   std::optional<int> bounces;
-  std::optional<int> threads;  // default: all cores
+  std::optional<int> threads;  // in [1, kMaxThreads]; default: all cores
   // Smallest element, as a fraction of the scene's total area (1e-5 of an
   // 80 m2 room is a 3 cm square).
   double min_element_area = 1e-5;
@@ -74,7 +93,7 @@ struct SolveStats {
   double threshold = 0.0;    // of the last complete pass
   std::size_t skipped_faces = 0;
   bool cancelled = false;
-  std::string stopped_by;    // "quality", "max_elements", "time_budget", "cancel"
+  std::string stopped_by;    // "quality", "max_elements", "memory", "time_budget", "cancel"
   double seconds = 0.0;
   double seconds_linking = 0.0;
   double seconds_clustering = 0.0;  // of linking: the walk over cluster pairs, with its rays

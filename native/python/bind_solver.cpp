@@ -234,24 +234,44 @@ VisibilityMode read_visibility(const std::string& name) {
   throw std::invalid_argument("visibility must be 'exact' or 'sampled', got '" + name + "'");
 }
 
+// Python's integers are unbounded: a count is range-checked here, so that any
+// int gives ValueError, never a TypeError or a wrapped value.
+int read_count(const py::object& value, const char* name, std::int64_t lo, std::int64_t hi) {
+  const std::string range = std::string(name) + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  if (!py::isinstance<py::int_>(value)) throw std::invalid_argument(range);
+  const auto within = [&](std::int64_t bound, int op) {
+    const py::int_ b(bound);
+    return PyObject_RichCompareBool(value.ptr(), b.ptr(), op) == 1;
+  };
+  if (!within(lo, Py_GE) || !within(hi, Py_LE))
+    throw std::invalid_argument(range + ", got " + py::repr(value).cast<std::string>());
+  return static_cast<int>(value.cast<std::int64_t>());
+}
+
 PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
-                  std::optional<std::int64_t> max_elements, std::optional<double> time_budget,
-                  const std::string& visibility, int rays, std::optional<int> bounces,
-                  std::optional<int> threads, const py::object& progress,
+                  const py::object& max_elements, std::optional<double> time_budget,
+                  const std::string& visibility, const py::object& rays, const py::object& bounces,
+                  const py::object& threads, const py::object& progress,
                   const py::object& cancel, double min_element_area, const std::string& leaf_links,
-                  std::optional<double> cluster_separation) {
+                  std::optional<double> cluster_separation, const py::object& memory_limit) {
   SolveOptions options;
   options.oracle = read_oracle(oracle);
   options.quality = quality;
-  if (max_elements) {
-    if (*max_elements < 1) throw std::invalid_argument("max_elements must be positive");
-    options.max_elements = static_cast<std::size_t>(*max_elements);
+  constexpr std::int64_t kMaxCount = std::int64_t{1} << 62;
+  if (!max_elements.is_none()) {
+    options.max_elements = static_cast<std::size_t>(read_count(max_elements, "max_elements", 1, INT32_MAX));
   }
   options.time_budget = time_budget;
   options.visibility = read_visibility(visibility);
-  options.rays = rays;
-  options.bounces = bounces;
-  options.threads = threads;
+  options.rays = read_count(rays, "rays", 1, 65536);
+  if (!bounces.is_none()) options.bounces = read_count(bounces, "bounces", 1, INT32_MAX);
+  if (!threads.is_none()) options.threads = read_count(threads, "threads", 1, kMaxThreads);
+  if (!memory_limit.is_none()) {
+    const auto v = py::cast<double>(py::float_(memory_limit));
+    if (!(v >= 1.0 && v <= static_cast<double>(kMaxCount)))
+      throw std::invalid_argument("memory_limit must be a positive number of bytes");
+    options.memory_limit = static_cast<std::size_t>(v);
+  }
   options.min_element_area = min_element_area;
   if (cluster_separation) {
     if (!(*cluster_separation > 1.0))
@@ -314,6 +334,7 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
 }  // namespace
 
 void bind_solver(py::module_& m) {
+  py::register_exception<InsufficientMemory>(m, "InsufficientMemoryError", PyExc_MemoryError);
   py::class_<CancelToken>(m, "CancelToken",
                           "A flag another thread can set to stop a solve; the solve then returns the "
                           "last complete pass.")
@@ -388,19 +409,22 @@ void bind_solver(py::module_& m) {
 
   m.def("solve", &py_solve, py::arg("scene"), py::arg("oracle") = "perceptual",
         py::arg("quality") = 0.5, py::arg("max_elements") = py::none(),
-        py::arg("time_budget") = py::none(), py::arg("visibility") = "exact", py::arg("rays") = 16,
+        py::arg("time_budget") = py::none(), py::arg("visibility") = "exact", py::arg("rays") = py::int_(16),
         py::arg("bounces") = py::none(), py::arg("threads") = py::none(),
         py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
         py::arg("min_element_area") = 1e-5, py::arg("leaf_links") = "near",
-        py::arg("cluster_separation") = py::none(),
+        py::arg("cluster_separation") = py::none(), py::arg("memory_limit") = py::none(),
         "Hierarchical radiosity. oracle: 'standard' | 'perceptual' | 'gradient'; quality in\n"
         "[0, 1] (0: no refinement); max_elements, time_budget (s): budgets; visibility:\n"
         "'exact' | 'sampled' (rays per sample); bounces: fixed iteration count instead of\n"
         "convergence; threads; progress(dict) callback; cancel: CancelToken;\n"
         "leaf_links: 'near' | 'all' | 'none', which links follow a split end down ('all': energy to 1e-3);\n"
         "cluster_separation: clusters of faces this many times their radii apart share one link\n"
-        "(default from quality, 2 to 10; inf: none).");
+        "(default from quality, 2 to 10; inf: none); memory_limit: bytes the elements and links may hold\n"
+        "(default 3/4 of the available memory): refinement stops there (stats['stopped_by'] == 'memory'),\n"
+        "and a scene that cannot fit unrefined raises MemoryError before any work.");
   m.def("quality_threshold", [](const std::string& oracle, double quality) {
+    if (!(quality >= 0.0 && quality <= 1.0)) throw std::invalid_argument("quality must lie in [0, 1]");
     return quality_threshold(read_oracle(oracle), quality);
   }, py::arg("oracle"), py::arg("quality"), "The oracle's refinement threshold at a quality level.");
 }
