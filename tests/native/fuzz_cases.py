@@ -491,7 +491,7 @@ def _planar(polygon):
     return length > 0 and np.all(np.abs((p - p[0]) @ (normal / length)) <= 1e-9 * diameter)
 
 
-def _run_kernel_call(rad, name, args, kwargs):
+def run_kernel_call(rad, name, args, kwargs):
     out = getattr(rad, name)(*args, **kwargs)
     # F to a planar polygon is a share of the receiver's hemisphere; the kernels
     # take non-planar ones too (what the contour integral gives is then no F).
@@ -534,7 +534,7 @@ def run_case(rad, kind, seed):
     calls = kernel_case(seed)
     for index, (name, args, kwargs) in enumerate(calls):
         try:
-            _run_kernel_call(rad, name, args, kwargs)
+            run_kernel_call(rad, name, args, kwargs)
         except ValueError as err:
             errors["%s: %s" % (name, message_class(err))] += 1
         except Finding as err:
@@ -675,7 +675,7 @@ class Campaign:
         lines = ["%d generated scenes, %d kernel calls (%d kernel cases) in %.1f s"
                  % (self.cases["scene"], self.calls["kernel"], self.cases["kernel"], self.seconds),
                  "%d findings (crashes, hangs, non-finite or malformed output)" % len(self.findings),
-                 "clean ValueErrors by message class:"]
+                 "%d clean ValueErrors, by message class:" % sum(self.errors.values())]
         for message, count in sorted(self.errors.items(), key=lambda kv: (-kv[1], kv[0])):
             lines.append("  %6d  %s" % (count, message))
         classes = {}

@@ -48,6 +48,9 @@ class FuzzSlice(unittest.TestCase):
                 cases.append(("kernel", i))
         campaign.run(cases)
         print(campaign.summary(), flush=True)
+        # run_tests.py shows these lines under the file's result.
+        for line in campaign.summary().splitlines()[:3]:
+            print("[summary] " + line, flush=True)
         self.assertEqual(campaign.cases["scene"], SCENES)
         self.assertEqual(campaign.cases["kernel"], KERNEL_CASES)
         if not campaign.findings:
