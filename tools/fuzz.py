@@ -26,6 +26,7 @@ Exits 1 if anything was found.
 """
 
 import argparse
+import base64
 import os
 import random
 import re
@@ -34,7 +35,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections import Counter, defaultdict
+from collections import defaultdict
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -168,7 +169,9 @@ def run_atheris(python, asan_lib, module_dir, seconds, folder, results):
     corpus.mkdir(parents=True, exist_ok=True)
     artifacts = folder / "artifacts" / "atheris"
     artifacts.mkdir(parents=True, exist_ok=True)
-    env = dict(os.environ, LD_PRELOAD=str(asan_lib), **SAN_ENV)
+    findings = folder / "atheris-findings.txt"
+    findings.unlink(missing_ok=True)
+    env = dict(os.environ, LD_PRELOAD=str(asan_lib), FUZZ_FINDINGS_FILE=str(findings), **SAN_ENV)
     deadline = time.monotonic() + seconds
     runs, rounds = 0, 0
     classes = defaultdict(list)
@@ -190,6 +193,18 @@ def run_atheris(python, asan_lib, module_dir, seconds, folder, results):
             if proc.returncode != 0:
                 saved = re.findall(r"Test unit written to (\S+)", text)
                 classes[finding_class(text)].append(saved[-1] if saved else "(round %d of %s)" % (rounds, logfile))
+    # Findings in Python, logged by the harness: one saved input per class.
+    if findings.exists():
+        for line in findings.read_text().splitlines():
+            what, _, data = line.partition("\t")
+            if not classes[what]:
+                path = artifacts / ("finding-%d" % len(classes))
+                path.write_bytes(base64.b64decode(data))
+                classes[what].append(str(path))
+            else:
+                classes[what].append("")
+    for items in classes.values():
+        items.sort(key=lambda item: item == "")
     results["atheris (Python API)"] = dict(runs=runs, seconds=seconds, classes=classes, unread=0, log=logfile)
 
 
@@ -226,7 +241,7 @@ def report(results, path):
                                                                  "  (%s)" % r["detail"] if "detail" in r else ""))
         for cls, items in sorted(r["classes"].items(), key=lambda kv: -len(kv[1])):
             lines.append("    x%-4d %s" % (len(items), cls))
-            for item in items[:3]:
+            for item in [i for i in items if i][:3]:
                 lines.append("           e.g. %s" % item)
         if r["unread"]:
             lines.append("    (%d more artifacts not rerun)" % r["unread"])

@@ -16,6 +16,7 @@ coverage), with atheris' ASan runtime preloaded.
     python atheris_api.py --path DIR_WITH__radiosity [libFuzzer options] [corpus dirs]
 """
 
+import base64
 import math
 import os
 import sys
@@ -188,6 +189,13 @@ def kernels(fdp):
             pass
 
 
+# With FUZZ_FINDINGS_FILE set (tools/fuzz.py does), a finding in Python (non-finite
+# or malformed output, an exception other than ValueError) is appended there as
+# "class<TAB>base64 of the input" and fuzzing goes on, so one known bug does not
+# end every run; crashes of the module itself still stop it (libFuzzer saves them).
+FINDINGS = os.environ.get("FUZZ_FINDINGS_FILE")
+
+
 def test_one_input(data):
     fdp = atheris.FuzzedDataProvider(data)
     try:
@@ -197,6 +205,12 @@ def test_one_input(data):
             scene_and_solve(fdp)
     except ValueError:
         pass  # a clean refusal
+    except Exception as err:  # noqa: BLE001  (a finding)
+        if not FINDINGS:
+            raise
+        what = "%s: %s" % (type(err).__name__, fuzz_cases.message_class(err))
+        with open(FINDINGS, "a") as out:
+            out.write("%s\t%s\n" % (what, base64.b64encode(data).decode()))
 
 
 def main():
