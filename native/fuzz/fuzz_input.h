@@ -94,6 +94,8 @@ inline bool planar_convex(std::span<const dvec3> polygon) {
   normal = glm::normalize(normal);
   for (const dvec3& v : polygon)
     if (std::abs(glm::dot(normal, v - polygon[0])) > 1e-9 * diameter) return false;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!(glm::length(polygon[(i + 1) % n] - polygon[i]) > 1e-9 * diameter)) return false;
   for (std::size_t i = 0; i < n; ++i) {
     const dvec3& a = polygon[i];
     const dvec3& b = polygon[(i + 1) % n];
