@@ -63,12 +63,18 @@ def build(args, folder):
          "radiosity_tests", "_radiosity", "addon", "_image_metric"])
 
 
-def libasan():
-    path = subprocess.run(["gcc", "-print-file-name=libasan.so"], check=True, capture_output=True,
-                          text=True).stdout.strip()
-    if not os.path.isabs(path):
-        raise SystemExit("gcc does not know where libasan.so is (%s)" % path)
-    return os.path.realpath(path)
+def preload():
+    """libasan first; libstdc++ too, so that ASan's __cxa_throw interceptor finds the
+    real one when it starts (Python does not link libstdc++: without it the first
+    C++ exception, a ValueError, aborts with "real___cxa_throw != 0")."""
+    paths = []
+    for name in ("libasan.so", "libstdc++.so"):
+        path = subprocess.run(["gcc", "-print-file-name=%s" % name], check=True, capture_output=True,
+                              text=True).stdout.strip()
+        if not os.path.isabs(path):
+            raise SystemExit("gcc does not know where %s is (%s)" % (name, path))
+        paths.append(os.path.realpath(path))
+    return " ".join(paths)
 
 
 def reports(text):
@@ -106,7 +112,7 @@ def run_ctest(folder):
 
 
 def run_python_tests(args, folder, tmp):
-    env = dict(os.environ, LD_PRELOAD=libasan(),
+    env = dict(os.environ, LD_PRELOAD=preload(),
                ASAN_OPTIONS="detect_leaks=0:abort_on_error=1:allocator_may_return_null=1",
                UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1",
                PYTHONFAULTHANDLER="1")
