@@ -672,8 +672,12 @@ class Campaign:
         stderr = proc.stderr.read()
         code = proc.returncode
         what = ("signal %s" % signal.Signals(-code).name) if code < 0 else "exit code %d" % code
-        tail = "\n".join(stderr.strip().splitlines()[-12:])
-        self.findings.append((case[0], case[1], "crash (%s)\n%s" % (what, tail)))
+        lines = stderr.strip().splitlines()
+        # What a sanitizer or faulthandler said first, then where Python was.
+        heads = [line for line in lines
+                 if re.search(r"runtime error:|ERROR: \w+Sanitizer|SUMMARY: \w+Sanitizer|Fatal Python error", line)]
+        python = [line for line in lines if line.lstrip().startswith("File ")][:4]
+        self.findings.append((case[0], case[1], "crash (%s)\n%s" % (what, "\n".join(heads[:4] + python))))
         self.cases[case[0]] += 1
 
     def summary(self, examples=3):
