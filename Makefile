@@ -20,7 +20,8 @@ ifdef CI
 CMAKE_ARGS += -DRADIOSITY_WERROR=ON
 endif
 
-.PHONY: all deps portable configure build test unit demo scenes package bench figures clean blenders validator
+.PHONY: all deps portable configure build test unit demo scenes package bench figures clean blenders validator \
+        fuzz sanitize
 
 # The command that runs $(BLENDER), installing it first if it is a bpy not yet installed.
 BLENDER_EXE = "$$($(PYTHON) tools/blenders.py install --build $(BUILD) $(BLENDER) >&2 && \
@@ -80,6 +81,19 @@ FIGURE_SIZE ?= 512
 figures: deps configure
 	@cmake --build $(BUILD) -j $(JOBS) --target visibility_figures
 	@$(BUILD)/tools/visibility_figures $(BUILD)/figures $(FIGURE_SIZE)
+
+# Issue 19's fuzzing campaign for FUZZ_SECONDS (tools/fuzz.py): the libFuzzer harnesses
+# of native/fuzz and atheris over the Python API (clang 16 and atheris installed for it
+# alone, into the system and $(BUILD)/fuzz/venv), then the slice's generators with new seeds.
+FUZZ_SECONDS ?= 600
+fuzz:
+	@bash .ci/install-deps.sh fuzz
+	@$(PYTHON) tools/fuzz.py --build $(BUILD) --seconds $(FUZZ_SECONDS) --jobs $(JOBS)
+
+# The C++ unit tests and tests/native under AddressSanitizer and UndefinedBehaviorSanitizer,
+# built into $(BUILD)/sanitize (tools/sanitize.py).
+sanitize: deps
+	@$(PYTHON) tools/sanitize.py --build $(BUILD) --jobs $(JOBS)
 
 clean:
 	rm -rf $(BUILD)

@@ -11,6 +11,13 @@ packages=(
   xvfb libgl1-mesa-dri  # the interactive (modal, ESC) test runs Blender in a virtual display
 )
 
+# `make fuzz` (tools/fuzz.py) builds its libFuzzer harnesses and an instrumented
+# module with clang 16 (Debian 12's clang 14 lacks _Float16 on x86-64) and its
+# compiler-rt (libFuzzer, the sanitizers): only asked for by `install-deps.sh fuzz`.
+if [[ "${1:-}" == fuzz ]]; then
+  packages+=(clang-16 libclang-rt-16-dev)
+fi
+
 # Node.js and npm run the Khronos glTF validator (tools/gltf_validator.py, which
 # installs the validator itself into the build tree). Checked by command: a
 # Node.js from elsewhere (NodeSource's nodejs, which includes npm) will do.

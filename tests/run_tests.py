@@ -183,6 +183,9 @@ def run_unittest_file(name, cmd, json_out, timeout, verbose):
         parts.append("--- end of process output ---\n" + tail(output, LOG_TAIL // 4))
     elif verbose:
         parts.append(output)
+    else:
+        # Lines a test prints for the summary (tests/native/test_fuzz.py's counts).
+        parts += [line for line in output.splitlines() if line.startswith("[summary] ")]
     passed = report["passed"]
     ran = passed + failed + report["skipped"] > 0
     return Outcome(name, passed, failed, seconds, "\n".join(parts), ran=ran, skipped=report["skipped"])

@@ -91,7 +91,9 @@ ForeignVertices::ForeignVertices(const Hierarchy& h) {
     };
     struct CellHash {
       size_t operator()(const glm::i64vec3& c) const {
-        return static_cast<size_t>(c.x * 73856093 ^ c.y * 19349663 ^ c.z * 83492791);
+        // Unsigned: the products of far cells overflow (UBSan, make fuzz's scene harness).
+        const glm::u64vec3 u(c);
+        return static_cast<size_t>(u.x * 73856093u ^ u.y * 19349663u ^ u.z * 83492791u);
       }
     };
     std::unordered_map<glm::i64vec3, std::vector<std::uint32_t>, CellHash> grid;

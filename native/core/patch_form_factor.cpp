@@ -143,9 +143,13 @@ constexpr std::array<double, 4> kGauss7W = {
     0.381830050505118944950369775488975, 0.417959183673469387755102040816327};
 
 // |K15 - G7| measures G7's error, far above K15's on smooth integrands; the
-// QUADPACK scaling (200 |K - G| / scale)^1.5 estimates K15's own.
+// QUADPACK scaling (200 |K - G| / scale)^1.5 estimates K15's own. `splits`
+// bounds the subdivisions of one integral: where the integrand's rounding
+// exceeds the tolerance (a face 1e-12 of its neighbour's size: f's own terms
+// cancel to 1 %), every interval would split down to depth 40, 2^40 of them.
+constexpr int kMaxSplits = 4096;
 template <class F>
-double gauss_kronrod(const F& f, double a, double b, double scale, double tolerance, int depth) {
+double gauss_kronrod(const F& f, double a, double b, double scale, double tolerance, int depth, int& splits) {
   const double mid = 0.5 * (a + b), half = 0.5 * (b - a);
   double kronrod = kKronrodW[7] * f(mid), gauss = kGauss7W[3] * f(mid);
   for (int i = 0; i < 7; ++i) {
@@ -154,9 +158,10 @@ double gauss_kronrod(const F& f, double a, double b, double scale, double tolera
     if (i % 2 == 1) gauss += kGauss7W[i / 2] * sum;
   }
   const double error = scale * std::pow(200.0 * std::abs(kronrod - gauss) * half / scale, 1.5);
-  if (error <= tolerance || depth >= 40) return kronrod * half;
-  return gauss_kronrod(f, a, mid, 0.5 * scale, 0.5 * tolerance, depth + 1) +
-         gauss_kronrod(f, mid, b, 0.5 * scale, 0.5 * tolerance, depth + 1);
+  if (error <= tolerance || depth >= 40 || splits <= 0) return kronrod * half;
+  --splits;
+  return gauss_kronrod(f, a, mid, 0.5 * scale, 0.5 * tolerance, depth + 1, splits) +
+         gauss_kronrod(f, mid, b, 0.5 * scale, 0.5 * tolerance, depth + 1, splits);
 }
 
 // Tanh-sinh nodes t = k h on [0, 3.5] for h = 1/2 at level 0, and the new (odd k)
@@ -285,8 +290,9 @@ double edge_pair_integral(const Edge& ei, const Edge& ej) {
     const double tolerance = 1e-14 * span * std::max(ej.length, 1e-3);
     const bool near_end = distance_to_segment(ei.start + a * ei.unit, ej) < 0.25 * span ||
                           distance_to_segment(ei.start + b * ei.unit, ej) < 0.25 * span;
+    int splits = kMaxSplits;
     total += near_end ? tanh_sinh(f, a, b, 1e-10 * span * ej.length)
-                      : gauss_kronrod(f, a, b, span * ej.length, tolerance, 0);
+                      : gauss_kronrod(f, a, b, span * ej.length, tolerance, 0, splits);
   }
   return total;
 }

@@ -517,7 +517,9 @@ bool merge_into_quad(const Triangle& a, const Triangle& b, double tol, dvec3 qua
       if (b.v[k] == p) ip = k;
       if (b.v[k] == q) iq = k;
     }
-    if (ip < 0 || iq < 0) continue;
+    // ip == iq: a's edge is degenerate (p == q); b's third vertex would be
+    // b.v[3 - 2 ip], outside b for ip 0 or 2 (UBSan, VisiblePolygon.DegenerateFuzz).
+    if (ip < 0 || iq < 0 || ip == iq) continue;
     const dvec3& x = b.v[3 - ip - iq];
     quad[0] = p, quad[1] = x, quad[2] = q, quad[3] = other;
     const dvec3 n = glm::cross(q - p, other - p);

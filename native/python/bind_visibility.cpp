@@ -40,6 +40,11 @@ void require_planar_convex(const std::vector<dvec3>& polygon, const std::string&
   for (const dvec3& v : polygon)
     if (std::abs(glm::dot(normal, v - polygon[0])) > 1e-9 * diameter)
       throw std::invalid_argument(name + " is not planar");
+  // An edge of no length (a repeated vertex) made every visible piece NaN
+  // (make fuzz: atheris and fuzz_visible_polygon); the hierarchy's elements have none.
+  for (std::size_t i = 0; i < n; ++i)
+    if (!(glm::length(polygon[(i + 1) % n] - polygon[i]) > 1e-9 * diameter))
+      throw std::invalid_argument(name + " has a repeated vertex (an edge of zero length)");
   for (std::size_t i = 0; i < n; ++i) {
     const dvec3& a = polygon[i];
     const dvec3& b = polygon[(i + 1) % n];

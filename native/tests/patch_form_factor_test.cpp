@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -407,6 +408,33 @@ TEST(PatchFormFactor, TinyAndHugeDistances) {
   const double f = patch_form_factor(tiny, p);
   EXPECT_LT(relative_error(f, form_factor(dvec3(0, 0, 1), dvec3(0, 0, -1), p)), 1e-6);
   EXPECT_LT(relative_error(patch_form_factor(p, tiny), f * 1e-18), 1e-6);
+}
+
+// Found by the fuzz slice (scene seed 4): next to a face 1e-12 of its size, the
+// integrand's own rounding exceeds the quadrature's tolerance, and the adaptive
+// Gauss-Kronrod split every interval down to depth 40 (2^40 of them: the solve
+// never returned). The subdivisions are now bounded.
+TEST(PatchFormFactor, NeighbourOneTrillionthTheSizeReturns) {
+  const Polygon quad_p = {{-4.721087714336642e-10, -4.2729275236462975e-09, -4.9719602538841866e-11},
+                          {5.020433486652835e-09, -3.2097653727151637e-09, -3.2096664895593493e-09},
+                          {4.3486241962839191e-09, -2.111938573966085e-09, -4.0080257994517912e-09},
+                          {-3.8029735139882818e-09, 1.1701537641651122e-09, -4.0080257994517904e-09}};
+  const Polygon tiny = {{-2.5779088494727169e-09, -2.3716603553894362e-11, -2.4121532306288478e-09},
+                        {-2.5779088494722595e-09, -2.3716603554321239e-11, -2.4121532306303872e-09},
+                        {-2.5779088494707292e-09, -2.3716603554665055e-11, -2.4121532306298371e-09},
+                        {-2.5779088494711866e-09, -2.3716603554238178e-11, -2.4121532306282978e-09}};
+  const auto start = std::chrono::steady_clock::now();
+  const double f = patch_form_factor(quad_p, tiny);
+  const double back = patch_form_factor(tiny, quad_p);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 5.0);
+  EXPECT_TRUE(std::isfinite(f));
+  EXPECT_TRUE(std::isfinite(back));
+  // What reaches a face 1e-24 of the quad's area is nothing at double precision.
+  EXPECT_GE(f, 0.0);
+  EXPECT_LT(f, 1e-12);
+  EXPECT_GE(back, 0.0);
+  EXPECT_LE(back, 1.0);
 }
 
 }  // namespace

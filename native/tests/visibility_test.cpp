@@ -470,6 +470,25 @@ TEST(VisiblePolygon, DegenerateConfigurations) {
 // rays from r through emitter vertices and the planes through r and emitter
 // edges (exact D1/D2 events), at r itself; edges parallel to emitter edges;
 // duplicated and edge-sharing triangles; slivers, tiny and huge triangles.
+// An occluder triangle with two equal vertices followed by one holding that
+// vertex last: merge_into_quad read b.v[-1] (UBSan in make sanitize found it
+// through DegenerateFuzz); this case fails there without the fix.
+TEST(VisiblePolygon, DegenerateTriangleBeforeANeighbourSharingItsVertex) {
+  const std::vector<dvec3> emitter = {{-0.5, -0.5, 2.0}, {-0.5, 0.5, 2.0}, {0.5, 0.5, 2.0}, {0.5, -0.5, 2.0}};
+  const dvec3 p(0.1, 0.05, 1.0), q(0.45, -0.1, 0.9);
+  Triangle a, b;
+  a.v = {p, p, q};
+  b.v = {dvec3(-0.2, 0.1, 1.1), dvec3(0.3, 0.3, 1.2), p};
+  const std::vector<Triangle> occluders = {a, b};
+  const FormFactorGradient fg = visible_form_factor_gradient(dvec3(0.0), dvec3(0, 0, 1), emitter, occluders);
+  const double unoccluded = form_factor(dvec3(0.0), dvec3(0, 0, 1), emitter);
+  EXPECT_TRUE(std::isfinite(fg.value) && std::isfinite(glm::length(fg.gradient)));
+  // b alone is in the way (a has no area).
+  const FormFactorGradient b_only = visible_form_factor_gradient(dvec3(0.0), dvec3(0, 0, 1), emitter, std::vector<Triangle>{b});
+  EXPECT_NEAR(fg.value, b_only.value, 1e-12);
+  EXPECT_LT(fg.value, unoccluded);
+}
+
 TEST(VisiblePolygon, DegenerateFuzz) {
   std::mt19937_64 rng(37);
   std::uniform_real_distribution<double> uni(0.0, 1.0);

@@ -126,6 +126,8 @@ class Validation(unittest.TestCase):
         self.check("zero area", emitter=[[0, 0, 2], [1, 0, 2], [2, 0, 2]])
         self.check("not planar", emitter=[[0, 0, 2], [1, 0, 2], [1, 1, 2.5], [0, 1, 2]])
         self.check("not convex", emitter=[[0, 0, 2], [2, 0, 2], [0.5, 0.5, 2], [0, 2, 2]])
+        # A repeated vertex made every visible piece NaN (make fuzz, issue 19).
+        self.check("repeated vertex", emitter=[[-0.5, -0.5, 2], [-0.5, -0.5, 2], [0.5, 0.5, 2], [0.5, -0.5, 2]])
 
     def test_bad_mode_and_rays(self):
         self.check("mode", mode="approximate")
