@@ -85,6 +85,19 @@ def visibility_hint(visibility, stats):
             "is many times faster" % stats["seconds_linking"])
 
 
+# The interactive solve in progress (at most one: the operator is modal), so
+# that scripts and the UI can follow it.
+_running_job = None
+
+
+def running_progress():
+    """The progress dict of the interactive solve running now (the solver's
+    last report: pass, passes, phase, elements, links, seconds, fraction), or
+    None when none runs."""
+    job = _running_job
+    return None if job is None else dict(job.progress)
+
+
 def progress_text(progress):
     """One line describing a progress dict of the solver."""
     if not progress:
@@ -127,7 +140,8 @@ class RADIOSITY_OT_solve(Operator):
             return {'CANCELLED'}
         except Exception as err:
             return self._unexpected(err)
-        self._job = job
+        global _running_job
+        self._job = _running_job = job
         self._token = solver.CancelToken()
         self._thread = threading.Thread(target=self._work, args=(solver, job, self._token),
                                         name="radiosity-solve", daemon=True)
@@ -166,6 +180,8 @@ class RADIOSITY_OT_solve(Operator):
         self._stop_modal(context)
 
     def _stop_modal(self, context):
+        global _running_job
+        _running_job = None
         wm = context.window_manager
         if self._timer is not None:
             wm.event_timer_remove(self._timer)

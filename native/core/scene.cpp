@@ -228,6 +228,13 @@ Scene make_scene(const SceneArrays& a) {
       << " cannot be solved (scale the scene up)";
     fail(m.str());
   }
+  const double reach = std::max(glm::length(lo), glm::length(hi));
+  if (!(scene.diameter >= kMinRelativeSize * reach)) {
+    std::ostringstream m;
+    m << "the scene is " << scene.diameter << " across but " << reach
+      << " from the origin: too far for its size to be solved precisely (move it to the origin)";
+    fail(m.str());
+  }
 
   size_t offset = 0;
   std::vector<dvec3> polygon;

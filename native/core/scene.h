@@ -18,12 +18,15 @@ namespace radiosity {
 
 // The range of input the solver computes in: radiance (emission, lights, the
 // world) up to kMaxInputRadiance, so that every bounce stays far inside the
-// float32 output (3.4e38); coordinates within kMaxCoordinate and a scene at
-// least kMinSceneSize across (form factors square and cube distances in
-// double precision). Larger or smaller input is refused before any work.
+// float32 output (3.4e38); coordinates within kMaxCoordinate; a scene at least
+// kMinSceneSize across (a point light's I / d^2 over a micrometre scene
+// already reaches 1e12 I) and at least kMinRelativeSize of its distance from
+// the origin (the ray tracer works in float32). Other input is refused
+// before any work (fuzzing found NaN and Inf beyond these limits).
 inline constexpr double kMaxInputRadiance = 1e30;
 inline constexpr double kMaxCoordinate = 1e30;
-inline constexpr double kMinSceneSize = 1e-30;
+inline constexpr double kMinSceneSize = 1e-6;
+inline constexpr double kMinRelativeSize = 1e-6;
 
 // Views on the caller's arrays (numpy, without copies).
 struct SceneArrays {

@@ -24,6 +24,7 @@ def fail(err):
 
 
 addon_utils.enable("radiosity", default_set=False, handle_error=fail)
+from radiosity import operators  # noqa: E402  (the add-on, enabled above)
 state = {"start": None, "invoke": None, "progress_seen": False}
 
 
@@ -40,8 +41,18 @@ def start():
     state["start"] = time.time()
 
 
+def first_pass_done():
+    progress = operators.running_progress()
+    return bool(progress) and (progress.get("phase") == "pass" or progress.get("pass", 0) >= 1)
+
+
 def escape():
+    # After the first complete pass, however loaded the machine (a fixed delay
+    # failed when the machine was busy), and before the solve at quality 1 ends.
+    if state["start"] is None or not first_pass_done():
+        return 0.05
     window().event_simulate(type='ESC', value='PRESS')
+    return None
 
 
 def check():
@@ -64,7 +75,5 @@ def check():
 
 bpy.app.timers.register(start, first_interval=1.0)
 if MODE == "cancel":
-    # Late enough that the first pass (linking and the unrefined solve) is done
-    # on a loaded machine, early enough that the solve at quality 1 is not.
-    bpy.app.timers.register(escape, first_interval=8.0)
+    bpy.app.timers.register(escape, first_interval=1.2)
 bpy.app.timers.register(check, first_interval=1.5)

