@@ -139,12 +139,13 @@ def set_colour_attribute(mesh, rgb, domain):
 
 
 def write_refined(scene, exported, result, show_wireframe=False, convert=None, material=None,
-                  lighting=False):
+                  lighting=False, replace_previous=None):
     """Replace the result objects by the solution's meshes. Returns the new objects.
     `convert` maps the (V, 3) radiance to the colours written and `material`
     replaces "Radiosity Emission" (game-ready colours: game_export.bake_options).
     `lighting`: with lighting copies of the originals' materials (bake_materials.py)
-    instead (the copies of lights' parts keep `material`)."""
+    instead (the copies of lights' parts keep `material`). `replace_previous(scene)` takes
+    the previous result away (default remove_results; a SceneTransaction retires it)."""
     face_part = exported.arrays["face_part"]
     polygon_part = face_part[np.asarray(result.source_face, dtype=np.int64)]
     pieces = geometry.split_result(result.face_vertices, result.face_sizes, polygon_part,
@@ -194,7 +195,7 @@ def write_refined(scene, exported, result, show_wireframe=False, convert=None, m
             bpy.data.meshes.remove(mesh)
         bake_materials.remove_unused()
         raise
-    remove_results(scene)
+    (replace_previous or remove_results)(scene)
     coll = result_collection(scene)
     for obj in new_objects:
         coll.objects.link(obj)
@@ -316,9 +317,13 @@ class OriginalsShown:
     def __enter__(self):
         self.hidden = [o.name for o in self.scene.objects if o.get(HIDDEN_TAG)]
         self.states = {n: self.scene.objects[n][HIDDEN_TAG] for n in self.hidden}
-        restore_originals(self.scene, self.view_layer)
-        if self.hidden:
-            self.view_layer.update()
+        try:
+            restore_originals(self.scene, self.view_layer)
+            if self.hidden:
+                self.view_layer.update()
+        except BaseException:  # hide them again: a failed export changes nothing
+            self.__exit__(None, None, None)
+            raise
         return self
 
     def __exit__(self, *exc):

@@ -23,7 +23,7 @@ import bpy
 import numpy as np
 from bpy.types import Operator
 
-from . import bake, export, game_export, native
+from . import bake, export, game_export, native, result_state
 
 STATUS = {
     "quality": "Converged",
@@ -295,17 +295,20 @@ class RADIOSITY_OT_solve(Operator):
             convert, material, note = game_export.bake_options(scene)
             if note:
                 warnings.append(note)
-        if mode in {'REFINED', 'BOTH', 'LIGHTING'}:
-            bake.write_refined(scene, job.exported, result, settings.show_wireframe,
-                               convert=convert, material=material, lighting=mode == 'LIGHTING')
-            bake.hide_originals(scene, context.view_layer, job.exported.hidden_sources)
-            bake.show_results(scene, True)
-        else:
-            bake.remove_results(scene)
-            bake.restore_originals(scene, context.view_layer)
-        if mode in {'ORIGINAL', 'BOTH'}:
-            skipped_objects = bake.write_original(scene, job.exported, result, convert=convert)
-        bake.set_viewport_attribute_colour()
+        # One transaction: a failure at any step leaves the scene as it was (result_state.py).
+        with result_state.SceneTransaction(scene, context.view_layer) as transaction:
+            if mode in {'REFINED', 'BOTH', 'LIGHTING'}:
+                bake.write_refined(scene, job.exported, result, settings.show_wireframe,
+                                   convert=convert, material=material, lighting=mode == 'LIGHTING',
+                                   replace_previous=lambda _: transaction.retire_results())
+                bake.hide_originals(scene, context.view_layer, job.exported.hidden_sources)
+                bake.show_results(scene, True)
+            else:
+                transaction.retire_results()
+                bake.restore_originals(scene, context.view_layer)
+            if mode in {'ORIGINAL', 'BOTH'}:
+                skipped_objects = bake.write_original(scene, job.exported, result, convert=convert)
+            bake.set_viewport_attribute_colour()
 
         note = export.unmodelled_message(job.exported.unmodelled)
         if note:
