@@ -194,6 +194,14 @@ void check_values(const SceneArrays& a) {
       fail(m.str());
     }
   }
+  // A face that casts no shadow stands for a light (Blender's light objects):
+  // it would receive light through surfaces it lies on, so it must not reflect.
+  for (size_t f = 0; f < a.occludes.size(); ++f) {
+    if (a.occludes[f] == 0 && (a.reflectance[3 * f] > 0.0 || a.reflectance[3 * f + 1] > 0.0 || a.reflectance[3 * f + 2] > 0.0)) {
+      fail("face " + std::to_string(f) + " casts no shadow (occludes is False) but reflects: such a face stands for a "
+           "light and must have reflectance 0");
+    }
+  }
   for (size_t i = 0; i < a.emission.size(); ++i) {
     const double e = a.emission[i];
     if (!std::isfinite(e) || e < 0.0 || e > kMaxInputRadiance) {

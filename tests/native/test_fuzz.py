@@ -37,10 +37,7 @@ TIMEOUT = float(os.environ.get("FUZZ_CASE_TIMEOUT", "60"))
 
 # Findings known and still open, by (kind, seed): reported, not failed on, and
 # required to reproduce (when one is fixed, take it off this list).
-KNOWN_OPEN = {
-    ("scene", 1482): "three coincident copies of one non-planar octagon (one two-sided, one white) lit by a "
-                     "sun, refined: NaN irradiance, caught by the solve's output check (RuntimeError)",
-}
+KNOWN_OPEN = {}
 
 
 class FuzzSlice(unittest.TestCase):

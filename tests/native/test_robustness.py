@@ -115,6 +115,16 @@ class OutOfRange(unittest.TestCase):
                 with self.assertRaises(ValueError):
                     rad.solve(self.scene, **kwargs)
 
+    def test_a_face_that_casts_no_shadow_must_not_reflect(self):
+        # Fuzz seed 1482: coincident copies of a face, some casting no shadow
+        # and reflecting, exchanged light at distance 0 (NaN).
+        a = self.builder.arrays()
+        occludes = np.ones(len(a["face_sizes"]), bool)
+        occludes[2] = False
+        with self.assertRaisesRegex(ValueError, "face 2 casts no shadow .* must have reflectance 0"):
+            rad.Scene(a["positions"], a["face_vertices"], a["face_sizes"], a["reflectance"], a["emission"],
+                      occludes=occludes)
+
     def test_face_sizes_that_wrap_around_are_refused(self):
         a = self.builder.arrays()
         sizes = a["face_sizes"].copy()
