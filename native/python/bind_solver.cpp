@@ -349,7 +349,7 @@ void bind_solver(py::module_& m) {
                     "face_sizes (F,) vertices per face (3 or more; larger polygons are triangulated);\n"
                     "reflectance (F, 3) in [0, 1]; emission (F, 3) radiance >= 0; two_sided (F,) bool,\n"
                     "default all True (a one-sided face has only its front: area lights); occludes (F,) bool,\n"
-                    "default all True (False: the face emits but casts no shadow, as Blender's lights).\n"
+                    "default all True (False: the face emits but casts no shadow and must not reflect, as Blender's lights).\n"
                     "lights: list of dicts, each {'type': 'point', 'position', 'intensity' (H = I cos / d^2),\n"
                     "'radius', 'shape': 'sphere' | 'disk'}, {'type': 'spot', the same and 'direction' (its axis),\n"
                     "'cos_half_angle', 'blend_width', 'cosine_falloff'} or {'type': 'sun', 'direction' (the way\n"
