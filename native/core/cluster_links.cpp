@@ -27,8 +27,10 @@ bool none_facing(const ClusterNode& node, const dvec3& w, double cone) {
 // light: facing the same way (each side sees only what rises above its own
 // plane, and the other must see it back), or facing opposite ways with no
 // side of the emitter above a side of the receiver (the two halves of a
-// two-sided floor). Exact pruning: the walk would reach the same verdict at
-// every pair of leaves, n^2 pairs over a tiled floor.
+// two-sided floor). The walk would reach the same verdict at every pair of
+// leaves (n^2 pairs over a tiled floor), but for grazing cluster links between
+// coplanar sides, which carry no light (3 of 286 in a 300-face box field; the
+// radiance moved by 2e-7).
 bool flat_pair_apart(const ClusterNode& rx, const ClusterNode& ry) {
   if (!rx.is_flat() || !ry.is_flat()) return false;
   const double c = glm::dot(rx.axis, ry.axis);
