@@ -238,14 +238,19 @@ VisibilityMode read_visibility(const std::string& name) {
 // int gives ValueError, never a TypeError or a wrapped value.
 int read_count(const py::object& value, const char* name, std::int64_t lo, std::int64_t hi) {
   const std::string range = std::string(name) + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
-  if (!py::isinstance<py::int_>(value)) throw std::invalid_argument(range);
+  // Anything with __index__ (int, numpy integers); not floats.
+  const auto index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+  if (!index) {
+    PyErr_Clear();
+    throw std::invalid_argument(range + ", got " + py::repr(value).cast<std::string>());
+  }
   const auto within = [&](std::int64_t bound, int op) {
     const py::int_ b(bound);
-    return PyObject_RichCompareBool(value.ptr(), b.ptr(), op) == 1;
+    return PyObject_RichCompareBool(index.ptr(), b.ptr(), op) == 1;
   };
   if (!within(lo, Py_GE) || !within(hi, Py_LE))
     throw std::invalid_argument(range + ", got " + py::repr(value).cast<std::string>());
-  return static_cast<int>(value.cast<std::int64_t>());
+  return static_cast<int>(index.cast<std::int64_t>());
 }
 
 PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,

@@ -125,6 +125,10 @@ class OutOfRange(unittest.TestCase):
             rad.Scene(a["positions"], a["face_vertices"], a["face_sizes"], a["reflectance"], a["emission"],
                       occludes=occludes)
 
+    def test_counts_take_numpy_integers(self):
+        result = rad.solve(self.scene, quality=0.0, threads=np.int64(2), rays=np.int32(4), max_elements=np.uint64(10**6))
+        assert_finite(self, result)
+
     def test_face_sizes_that_wrap_around_are_refused(self):
         a = self.builder.arrays()
         sizes = a["face_sizes"].copy()
