@@ -685,4 +685,26 @@ void visible_form_factor_gradient_parts(const dvec3& r, const dvec3& n, std::spa
     out[i] = occluded ? part_form_factor_gradient(w, parts[i]) : form_factor_gradient(r, n, parts[i]);
 }
 
+const char* planar_convex_problem(std::span<const dvec3> polygon) {
+  const std::size_t n = polygon.size();
+  dvec3 normal(0.0);
+  double diameter = 0.0;
+  for (std::size_t i = 1; i + 1 < n; ++i) normal += glm::cross(polygon[i] - polygon[0], polygon[i + 1] - polygon[0]);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j) diameter = std::max(diameter, glm::length(polygon[i] - polygon[j]));
+  normal = glm::normalize(normal);
+  for (const dvec3& v : polygon)
+    if (std::abs(glm::dot(normal, v - polygon[0])) > 1e-9 * diameter) return "is not planar";
+  for (std::size_t i = 0; i < n; ++i)
+    if (!(glm::length(polygon[(i + 1) % n] - polygon[i]) > 1e-9 * diameter))
+      return "has a repeated vertex (an edge of zero length)";
+  for (std::size_t i = 0; i < n; ++i) {
+    const dvec3& a = polygon[i];
+    const dvec3& b = polygon[(i + 1) % n];
+    const dvec3& c = polygon[(i + 2) % n];
+    if (glm::dot(glm::cross(b - a, c - b), normal) < -1e-12 * diameter * diameter) return "is not convex";
+  }
+  return nullptr;
+}
+
 }  // namespace radiosity

@@ -74,4 +74,9 @@ void visible_form_factor_gradient_parts(const dvec3& r, const dvec3& n, std::spa
                                         std::span<const Triangle> occluders,
                                         std::span<FormFactorGradient> out);
 
+// The emitters this code is exact for: planar and convex, with no repeated
+// vertex (an edge of zero length made every visible piece NaN). nullptr if
+// `polygon` is one, else what is wrong ("is not planar", ...), for a message.
+const char* planar_convex_problem(std::span<const dvec3> polygon);
+
 }  // namespace radiosity

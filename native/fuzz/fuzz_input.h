@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/form_factor.h"
+#include "core/visible_polygon.h"
 #include "core/vec.h"
 
 namespace radiosity::fuzz {
@@ -83,27 +84,7 @@ inline bool valid_polygon(std::span<const dvec3> polygon) {
 }
 
 // python/bind_visibility.cpp, require_planar_convex.
-inline bool planar_convex(std::span<const dvec3> polygon) {
-  const std::size_t n = polygon.size();
-  dvec3 normal(0.0);
-  double diameter = 0.0;
-  for (std::size_t i = 1; i + 1 < n; ++i)
-    normal += glm::cross(polygon[i] - polygon[0], polygon[i + 1] - polygon[0]);
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = i + 1; j < n; ++j) diameter = std::max(diameter, glm::length(polygon[i] - polygon[j]));
-  normal = glm::normalize(normal);
-  for (const dvec3& v : polygon)
-    if (std::abs(glm::dot(normal, v - polygon[0])) > 1e-9 * diameter) return false;
-  for (std::size_t i = 0; i < n; ++i)
-    if (!(glm::length(polygon[(i + 1) % n] - polygon[i]) > 1e-9 * diameter)) return false;
-  for (std::size_t i = 0; i < n; ++i) {
-    const dvec3& a = polygon[i];
-    const dvec3& b = polygon[(i + 1) % n];
-    const dvec3& c = polygon[(i + 2) % n];
-    if (glm::dot(glm::cross(b - a, c - b), normal) < -1e-12 * diameter * diameter) return false;
-  }
-  return true;
-}
+inline bool planar_convex(std::span<const dvec3> polygon) { return planar_convex_problem(polygon) == nullptr; }
 
 // python/numpy_input.cpp, read_unit_vec3: finite, non-zero, normalised.
 inline bool unit_normal(const dvec3& v, dvec3& out) {

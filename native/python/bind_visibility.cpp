@@ -28,30 +28,7 @@ namespace {
 // The visible-polygon code needs a planar, convex emitter (the hierarchy's
 // triangles and quads are): say so here rather than return a wrong number.
 void require_planar_convex(const std::vector<dvec3>& polygon, const std::string& name) {
-  const std::size_t n = polygon.size();
-  dvec3 normal(0.0);
-  double diameter = 0.0;
-  for (std::size_t i = 1; i + 1 < n; ++i)
-    normal += glm::cross(polygon[i] - polygon[0], polygon[i + 1] - polygon[0]);
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = i + 1; j < n; ++j)
-      diameter = std::max(diameter, glm::length(polygon[i] - polygon[j]));
-  normal = glm::normalize(normal);
-  for (const dvec3& v : polygon)
-    if (std::abs(glm::dot(normal, v - polygon[0])) > 1e-9 * diameter)
-      throw std::invalid_argument(name + " is not planar");
-  // An edge of no length (a repeated vertex) made every visible piece NaN
-  // (make fuzz: atheris and fuzz_visible_polygon); the hierarchy's elements have none.
-  for (std::size_t i = 0; i < n; ++i)
-    if (!(glm::length(polygon[(i + 1) % n] - polygon[i]) > 1e-9 * diameter))
-      throw std::invalid_argument(name + " has a repeated vertex (an edge of zero length)");
-  for (std::size_t i = 0; i < n; ++i) {
-    const dvec3& a = polygon[i];
-    const dvec3& b = polygon[(i + 1) % n];
-    const dvec3& c = polygon[(i + 2) % n];
-    if (glm::dot(glm::cross(b - a, c - b), normal) < -1e-12 * diameter * diameter)
-      throw std::invalid_argument(name + " is not convex");
-  }
+  if (const char* problem = planar_convex_problem(polygon)) throw std::invalid_argument(name + " " + problem);
 }
 
 std::vector<Triangle> read_triangles(const py::handle& object, const std::string& name) {
