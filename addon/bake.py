@@ -199,8 +199,10 @@ def write_refined(scene, exported, result, show_wireframe=False, convert=None, m
     coll = result_collection(scene)
     for obj in new_objects:
         coll.objects.link(obj)
-        # Made while the old results still held the names: take them back.
-        obj.name = obj.data.name = obj["radiosity_name"]
+        # Made while the old results still held the names: take them back (a user's
+        # object or mesh of that name keeps it; the result takes name.001).
+        compat.set_name(bpy.data.objects, obj, obj["radiosity_name"])
+        compat.set_name(bpy.data.meshes, obj.data, obj["radiosity_name"])
     if copies is not None:
         copies.take_names()
     return new_objects
@@ -232,8 +234,9 @@ def write_original(scene, exported, result, convert=None):
             continue
         obj = scene.objects.get(part.source)
         mesh = obj.data if obj is not None and obj.type == 'MESH' else None
-        if (mesh is None or mesh.users > 1 or len(mesh.polygons) != part.face_count
-                or len(mesh.loops) != int(part.face_sizes.sum())):
+        exported = np.arange(part.face_count) if part.polygons is None else part.polygons
+        if (mesh is None or mesh.users > 1 or len(mesh.polygons) != (part.polygon_count or part.face_count)
+                or not np.array_equal(_loop_total(mesh)[exported], part.face_sizes)):
             skipped.append(part.source)
             continue
         targets.append((part, int(start), obj, mesh))
@@ -254,16 +257,23 @@ def write_original(scene, exported, result, convert=None):
         part_values = values[offset:offset + n]
         offset += n
         loop_start = np.empty(len(mesh.polygons), dtype=np.int32)
-        loop_total = np.empty(len(mesh.polygons), dtype=np.int32)
         mesh.polygons.foreach_get("loop_start", loop_start)
-        mesh.polygons.foreach_get("loop_total", loop_total)
+        loop_total = _loop_total(mesh)
+        if part.polygons is not None:   # faces left out of the solve stay black
+            loop_start, loop_total = loop_start[part.polygons], loop_total[part.polygons]
         loops = geometry.polygon_corners(loop_start, loop_total, np.arange(len(mesh.loops)))
         if np.linalg.det(np.array(obj.matrix_world)[:3, :3]) < 0:
             loops = geometry.reverse_polygons(loops, loop_total)
-        per_loop = np.empty((len(mesh.loops), 3), dtype=np.float32)
+        per_loop = np.zeros((len(mesh.loops), 3), dtype=np.float32)
         per_loop[loops] = part_values
         set_colour_attribute(mesh, per_loop, 'CORNER')
     return skipped
+
+
+def _loop_total(mesh):
+    total = np.empty(len(mesh.polygons), dtype=np.int32)
+    mesh.polygons.foreach_get("loop_total", total)
+    return total
 
 
 def remove_original_attributes(scene):

@@ -100,7 +100,7 @@ class LightingMaterials:
     def take_names(self):
         """Made while the last bake's copies still held the names: take them back."""
         for material in self._copies.values():
-            material.name = material[COPY_TAG + "_name"]
+            compat.set_name(bpy.data.materials, material, material[COPY_TAG + "_name"])
 
 
 def remove_unused():
@@ -119,7 +119,7 @@ def lighting_copy(material):
         _emission_only(copy, DEFAULT_COLOUR)
     else:
         copy = material.copy()
-        copy.name = name
+        compat.set_name(bpy.data.materials, copy, name)
         copy[COPY_TAG] = material.name_full
         copy.use_fake_user = False
         if not copy.use_nodes or copy.node_tree is None:

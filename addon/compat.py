@@ -83,3 +83,24 @@ def set_uv_layer(layer, values):
         vectors.foreach_set("vector", flat)
     else:
         layer.data.foreach_set("uv", flat)
+
+
+def set_name(collection, block, name):
+    """Name `block` (an ID of bpy.data `collection`) `name`, or `name.001`, `name.002`...
+    if another ID has it. Never asks Blender for a taken name: 3.4 then renames
+    whichever of the two sorts first, which may be the user's object (measured;
+    4.5 and 5.0 suffix the renamed one)."""
+    if block.name == name:
+        return
+    # Names are at most 63 bytes (255 since 5.0); what Blender would cut could be taken.
+    limit = bpy.types.ID.bl_rna.properties["name"].length_max - 1
+    number = 0
+    while True:
+        suffix = ".%03d" % number if number else ""
+        base = name.encode("utf-8")[:limit - len(suffix)].decode("utf-8", errors="ignore")
+        candidate = base + suffix
+        other = collection.get(candidate)
+        if other is None or other == block:
+            block.name = candidate
+            return
+        number += 1

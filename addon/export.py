@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import bpy
 import numpy as np
 
-from . import compat, geometry, light_units, surface_uv
+from . import compat, geometry, light_units, render_visibility, surface_uv
 
 # Objects the add-on itself made, which must never be solved again.
 RESULT_TAG = "radiosity_result"
@@ -38,6 +38,9 @@ HIDDEN_TAG = "radiosity_hidden"
 
 GEOMETRY_TYPES = {'MESH', 'CURVE', 'SURFACE', 'FONT', 'META'}
 DEFAULT_REFLECTANCE = (0.8, 0.8, 0.8)  # a face without material renders as grey 0.8 diffuse
+# What Cycles renders for an Image Texture without pixels (no image, a missing or
+# unreadable file): magenta, measured in 3.4, 4.5 and 5.0.
+MISSING_IMAGE = (1.0, 0.0, 1.0)
 
 
 @dataclass
@@ -59,6 +62,10 @@ class Part:
     uv_render: str = ""
     triangles: np.ndarray = None
     triangle_face: np.ndarray = None
+    # The evaluated mesh's polygons exported (None: all of them, in order), and
+    # how many it has: faces with non-finite coordinates are left out.
+    polygons: np.ndarray = None
+    polygon_count: int = 0
 
 
 @dataclass
@@ -69,6 +76,8 @@ class ExportedScene:
     hidden_sources: list      # names of original objects whose render visibility the bake may toggle
     lights: list = field(default_factory=list)  # point, spot and sun lights in the solver's form
     world: np.ndarray = None  # radiance of a uniform world, or None for black
+    # Input the export could not use as it is and what it did instead, for the warning.
+    repaired: list = field(default_factory=list)
 
     @property
     def face_count(self):
@@ -82,6 +91,7 @@ class MaterialReader:
         self._cache = {}
         self._images = {}
         self.unknown = set()
+        self.missing_images = set()  # "name (file)" of images without pixels
         # What was read but only approximated: reason -> material names.
         self.approximated = {}
 
@@ -159,8 +169,8 @@ class MaterialReader:
             return np.zeros(3)
         if node.type == 'RGB':
             return np.array(node.outputs[0].default_value[:3], dtype=float)
-        if node.type == 'TEX_IMAGE' and node.image is not None:
-            return self._image_average(node.image)
+        if node.type == 'TEX_IMAGE':
+            return self._image_colour(node.image)
         return None
 
     def _emission_colour(self, socket, material):
@@ -171,22 +181,36 @@ class MaterialReader:
             self._approximate(material, "emission texture averaged")
         return self._colour(socket, material)
 
-    def _image_average(self, image):
+    def _image_colour(self, image):
+        """An image's average; for a node without image or an image without pixels
+        (file missing or unreadable), what Cycles renders: magenta, named in the warning."""
+        if image is None:
+            self.missing_images.add("(Image Texture without image)")
+            return np.array(MISSING_IMAGE)
         key = image.name_full
         if key not in self._images:
             self._images[key] = _image_average(image)
+        if self._images[key] is None:
+            path = image.filepath
+            self.missing_images.add("%s (%s)" % (image.name, path) if path else image.name)
+            return np.array(MISSING_IMAGE)
         return self._images[key]
 
 
 def _image_average(image):
     """Mean linear RGB of an image, or None if it has no pixels."""
-    width, height = image.size
+    width, height = image.size  # (0, 0) when the file is missing or unreadable
     channels = image.channels
-    if width * height == 0 or channels < 3:
+    if width * height == 0 or channels < 1:
         return None
     pixels = np.empty(width * height * channels, dtype=np.float32)
     image.pixels.foreach_get(pixels)
-    rgb = pixels.reshape(-1, channels)[:, :3].astype(np.float64)
+    # A grey image (one or two channels) is its first channel in each of r, g, b.
+    rgb = pixels.reshape(-1, channels)[:, [0, 1, 2] if channels >= 3 else [0, 0, 0]].astype(np.float64)
+    # A float image's NaN or Inf pixels would make the whole surface so: left out.
+    rgb = rgb[np.isfinite(rgb).all(axis=1)]
+    if len(rgb) == 0:
+        return None
     # Byte images hold their colour space's encoded values; float ones are linear.
     if not image.is_float and image.colorspace_settings.name == 'sRGB':
         rgb = geometry.srgb_to_linear(rgb)
@@ -263,16 +287,24 @@ def _mesh_uvs(mesh, loop_start, loop_total):
 
 
 def _renderable(obj):
-    """An original object that a render would show (our own results excluded)."""
+    """An original object whose own flag lets a render show it (our own results excluded)."""
     if obj.get(RESULT_TAG):
         return False
     # Objects the add-on hid in renders are still part of the scene to solve.
     return not obj.hide_render or bool(obj.get(HIDDEN_TAG))
 
 
+def rendered_shown(view_layer):
+    """Context manager for the export: what a render shows is in the viewport's depsgraph."""
+    return render_visibility.RenderedShown(view_layer, _renderable)
+
+
 def export_scene(context, blender_version=None):
-    """Read the scene of `context` into an ExportedScene."""
+    """Read the scene of `context` into an ExportedScene: what a Cycles render of
+    its view layer shows (inside rendered_shown, also what the viewport hides)."""
     depsgraph = context.evaluated_depsgraph_get()
+    # Cycles leaves out what is disabled in renders, itself or by a collection.
+    rendered = render_visibility.rendered_objects(context.view_layer, _renderable)
     version = tuple(blender_version or bpy.app.version)
     builder = geometry.SceneBuilder()
     reader = MaterialReader()
@@ -282,18 +314,22 @@ def export_scene(context, blender_version=None):
     direct_lights = []
     hidden_sources = set()
     names_used = {}
+    non_finite = {}      # name -> (faces left out, faces), None for a light, where NaN or Inf coordinates
 
     for inst in depsgraph.object_instances:
         obj = inst.object
         original = obj.original
         owner = inst.parent.original if inst.is_instance and inst.parent else original
-        if not _renderable(original) or not _renderable(owner):
+        if not _renderable(original) or owner not in rendered:
             continue
         if not (inst.show_self if inst.is_instance else True):
             continue
         matrix = np.array(inst.matrix_world, dtype=float)
         if obj.type == 'LIGHT':
             light = obj.data
+            if not geometry.finite(matrix).all():
+                non_finite[owner.name] = None
+                continue
             if light.type != 'AREA':
                 solver_light = _direct_light(light, matrix, version)
                 if solver_light is None:
@@ -328,28 +364,51 @@ def export_scene(context, blender_version=None):
         positions, corners, sizes, material_index, uvs = _mesh_arrays(obj)
         if len(sizes) == 0:
             continue
-        world = geometry.transform_points(positions, matrix)
+        with np.errstate(invalid="ignore", over="ignore"):   # NaN and Inf are dealt with below
+            world = geometry.transform_points(positions, matrix)
+        # An Inf (a float's largest) rotated may come out finite: local coordinates count too.
+        world[~geometry.finite(positions).all(axis=1)] = np.nan
         mirrored = np.linalg.det(matrix[:3, :3]) < 0
         if mirrored:
             # A mirroring transform flips the winding; keep normals as Blender shows them.
             corners = geometry.reverse_polygons(corners, sizes)
+        name = original.name if not inst.is_instance else "%s (%s)" % (original.name, owner.name)
+        # The solver refuses non-finite coordinates: faces using one are left out, and named.
+        keep = geometry.finite_faces(world, corners, sizes)
+        polygon_count, polygons, corner_keep = len(sizes), None, None
+        if not keep.all():
+            non_finite[name] = (int(np.count_nonzero(~keep)), polygon_count)
+            if not keep.any():
+                continue
+            world, corners, sizes, corner_keep = geometry.keep_faces(world, corners, sizes, keep)
+            polygons, material_index = np.flatnonzero(keep), material_index[keep]
         materials = [slot.material for slot in obj.material_slots] or [None]
         table = [reader.read(m) for m in materials]
         rho_table = np.array([t[0] for t in table])
         emit_table = np.array([t[1] for t in table])
         slot = np.clip(material_index, 0, len(materials) - 1)
         builder.add(world, corners, sizes, rho_table[slot], emit_table[slot], True)
-        name = original.name if not inst.is_instance else "%s (%s)" % (original.name, owner.name)
         part = Part(name=_unique(names_used, name), source=owner.name,
                     is_instance=inst.is_instance, is_light=False, face_count=len(sizes),
                     corner_points=world[corners], face_sizes=sizes,
-                    materials=materials, material_index=slot)
+                    materials=materials, material_index=slot,
+                    polygons=polygons, polygon_count=polygon_count)
         if uvs is not None:
             part.uv_layers, part.triangles, part.triangle_face = uvs.corners(mirrored)
             part.uv_render = uvs.render
+            if polygons is not None:
+                _keep_uv_faces(part, keep, corner_keep)
         parts.append(part)
         hidden_sources.add(owner.name)
 
+    repaired = []
+    if non_finite:
+        repaired.append("non-finite (NaN or Inf) coordinates, left out: " + ", ".join(
+            _non_finite_text(name, non_finite[name]) for name in sorted(non_finite)))
+    if reader.missing_images:
+        names = sorted(reader.missing_images)
+        repaired.append("image%s without pixels (file missing or unreadable) read as magenta, as Cycles "
+                        "renders them: %s" % ("s" if len(names) > 1 else "", ", ".join(names)))
     unmodelled = []
     for kind in sorted(lights_not_modelled):
         count = lights_not_modelled[kind]
@@ -365,7 +424,27 @@ def export_scene(context, blender_version=None):
     if world_note:
         unmodelled.append(world_note)
     return ExportedScene(arrays=builder.arrays(), parts=parts, unmodelled=unmodelled,
-                         hidden_sources=sorted(hidden_sources), lights=direct_lights, world=world)
+                         hidden_sources=sorted(hidden_sources), lights=direct_lights, world=world,
+                         repaired=repaired)
+
+
+def _non_finite_text(name, counts):
+    if counts is None:
+        return "%s (a light)" % name
+    skipped, total = counts
+    if skipped == total:
+        return "%s (all %d face%s)" % (name, total, "s" if total > 1 else "")
+    return "%s (%d of %d faces)" % (name, skipped, total)
+
+
+def _keep_uv_faces(part, keep, corner_keep):
+    """A part's UV maps and triangles (surface_uv order) for its faces where `keep` only."""
+    corner_map = np.cumsum(corner_keep) - 1
+    face_map = np.cumsum(keep) - 1
+    part.uv_layers = {n: uv[corner_keep] for n, uv in part.uv_layers.items()}
+    kept = keep[part.triangle_face]
+    part.triangles = corner_map[part.triangles[kept]]
+    part.triangle_face = face_map[part.triangle_face[kept]]
 
 
 def _direct_light(light, matrix, version):

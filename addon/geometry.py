@@ -99,6 +99,33 @@ def reverse_polygons(face_vertices, face_sizes):
     return np.asarray(face_vertices)[np.repeat(starts + face_sizes - 1, face_sizes) - k]
 
 
+# Blender stores an Inf typed into a property as the largest float: as good as Inf.
+FLOAT_MAX = float(np.finfo(np.float32).max)
+
+
+def finite(values):
+    """True where finite and below FLOAT_MAX in magnitude (NaN compares False)."""
+    return np.abs(np.asarray(values, dtype=np.float64)) < FLOAT_MAX
+
+
+def finite_faces(positions, face_vertices, face_sizes):
+    """(F,) True where every corner of the face has finite coordinates (`finite`)."""
+    face_sizes = np.asarray(face_sizes, dtype=np.int64)
+    corner_ok = finite(np.asarray(positions, dtype=np.float64)[face_vertices]).all(axis=1)
+    bad = np.zeros(len(face_sizes), dtype=bool)
+    bad[np.repeat(np.arange(len(face_sizes)), face_sizes)[~corner_ok]] = True
+    return ~bad
+
+
+def keep_faces(positions, face_vertices, face_sizes, keep):
+    """Only the faces where `keep`, with only the vertices they use:
+    (positions, face_vertices, face_sizes, corner mask of the input corners)."""
+    face_sizes = np.asarray(face_sizes, dtype=np.int64)
+    corner_keep = np.repeat(np.asarray(keep, dtype=bool), face_sizes)
+    used, local = np.unique(np.asarray(face_vertices, dtype=np.int64)[corner_keep], return_inverse=True)
+    return np.asarray(positions)[used], local.reshape(-1), face_sizes[keep], corner_keep
+
+
 def srgb_to_linear(c):
     """sRGB-encoded values in [0, 1] to linear (the standard piecewise curve)."""
     c = np.asarray(c, dtype=np.float64)

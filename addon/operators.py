@@ -237,10 +237,13 @@ class RADIOSITY_OT_solve(Operator):
     def _prepare(self, context, solver):
         """Export the scene and make the native Scene (main thread)."""
         scene = context.scene
-        with bake.OriginalsShown(scene, context.view_layer):
+        # What a render shows, the originals the last solve hid included, is read,
+        # whatever the viewport hides; every flag is put back after.
+        with bake.OriginalsShown(scene, context.view_layer), export.rendered_shown(context.view_layer):
             exported = export.export_scene(context)
         arrays = exported.arrays
-        note = export.unmodelled_message(exported.unmodelled)
+        note = "; ".join(exported.repaired + ([export.unmodelled_message(exported.unmodelled)]
+                                              if exported.unmodelled else []))
         if exported.face_count == 0:
             raise SolveError("Nothing to solve: the scene has no visible mesh objects or area lights"
                              + (" (%s)" % note if note else ""))
@@ -310,6 +313,7 @@ class RADIOSITY_OT_solve(Operator):
                 skipped_objects = bake.write_original(scene, job.exported, result, convert=convert)
             bake.set_viewport_attribute_colour()
 
+        warnings.extend(job.exported.repaired)
         note = export.unmodelled_message(job.exported.unmodelled)
         if note:
             warnings.append(note)

@@ -12,7 +12,7 @@ previous result for good.
 
 import bpy
 
-from . import bake, bake_materials
+from . import bake, bake_materials, compat
 from .export import HIDDEN_TAG, RESULT_TAG
 
 RETIRED_SUFFIX = " (previous radiosity result)"
@@ -71,13 +71,14 @@ class SceneTransaction:
                         all(m is not r for r, _ in self.retired_materials):
                     self.retired_materials.append((m, m.name))
             coll.objects.unlink(obj)
-        # Free the names for the new result (lighting copies included).
+        # Free the names for the new result (lighting copies included); set_name,
+        # since a user's object may already carry a retired name.
         for obj, name, mesh_name in self.retired:
-            obj.name = name + RETIRED_SUFFIX
+            compat.set_name(bpy.data.objects, obj, name + RETIRED_SUFFIX)
             if obj.data is not None:
-                obj.data.name = mesh_name + RETIRED_SUFFIX
+                compat.set_name(bpy.data.meshes, obj.data, mesh_name + RETIRED_SUFFIX)
         for material, name in self.retired_materials:
-            material.name = name + RETIRED_SUFFIX
+            compat.set_name(bpy.data.materials, material, name + RETIRED_SUFFIX)
 
     def __exit__(self, kind, error, trace):
         if kind is None:
@@ -103,12 +104,12 @@ class SceneTransaction:
         for material in [m for m in bpy.data.materials if m not in self.materials and m.users == 0]:
             bpy.data.materials.remove(material)
         for material, name in self.retired_materials:
-            material.name = name
+            compat.set_name(bpy.data.materials, material, name)
         coll = bake.result_collection(self.scene, create=not self.had_collection and bool(self.retired))
         for obj, name, mesh_name in self.retired:
-            obj.name = name
+            compat.set_name(bpy.data.objects, obj, name)
             if obj.data is not None:
-                obj.data.name = mesh_name
+                compat.set_name(bpy.data.meshes, obj.data, mesh_name)
             if coll is not None and obj.name not in coll.objects:
                 coll.objects.link(obj)
         if not self.had_collection and coll is not None and not self.retired and len(coll.objects) == 0:
