@@ -1,19 +1,26 @@
-"""A solve that fails at any step (the export, or writing its result) leaves the
-scene exactly as it was, the previous result included (addon/result_state.py).
+"""A solve that fails or is cancelled at any step (the export, the native solve,
+writing its result) leaves the scene exactly as it was, the previous result
+included (addon/result_state.py).
 
 Each step the operator takes after the native solve (replacing the result
 objects, hiding the originals, showing the results, writing the attribute on
 the originals, switching the 3D views to attribute colours) is made to fail
-after doing its work, the worst case; the scene is then compared with the
-scene before the solve, down to the attribute values and the result meshes.
+after doing its work, the worst case; steps that loop (writing meshes, their
+attributes and lighting materials, writing the originals' attributes, hiding
+the originals) also fail half-way; the export fails with viewport-hidden
+objects shown for it, the native solve fails or refuses, and a solve is
+cancelled before its first pass. The scene is then compared with the scene
+before the solve, down to the attribute values, the result meshes and every
+visibility flag.
 """
 
+import threading
 import unittest
 
 import bpy
 import numpy as np
 
-from radiosity import bake, bake_materials
+from radiosity import bake, bake_materials, export, native, operators
 from test_addon import scene_snapshot
 from test_solve import open_scene
 
@@ -37,6 +44,33 @@ def failing_after(function):
     return step
 
 
+def failing_at_call(function, call):
+    """`function`, failing instead of its `call`-th call (1-based): half-way through a loop."""
+    count = [0]
+
+    def step(*args, **kwargs):
+        count[0] += 1
+        if count[0] == call:
+            raise InjectedFailure("injected at call %d of %s" % (call, function.__name__))
+        return function(*args, **kwargs)
+    return step
+
+
+class Patched:
+    """with Patched(module, name, wrap): module.name is wrap(original) inside."""
+
+    def __init__(self, module, name, wrap):
+        self.module, self.name, self.wrap = module, name, wrap
+
+    def __enter__(self):
+        self.original = getattr(self.module, self.name)
+        setattr(self.module, self.name, self.wrap(self.original))
+
+    def __exit__(self, *exc):
+        setattr(self.module, self.name, self.original)
+        return False
+
+
 def full_state(scene):
     """scene_snapshot plus what it leaves out: attribute values, result meshes, shading."""
     state = scene_snapshot(scene)
@@ -57,7 +91,28 @@ def full_state(scene):
                      for o in scene.objects}
     state["shading"] = [s.shading.color_type for scr in bpy.data.screens for a in scr.areas
                         for s in a.spaces if s.type == 'VIEW_3D']
+    layer = bpy.context.view_layer
+    state["object flags"] = {o.name: (o.hide_render, o.hide_viewport, o.hide_get(view_layer=layer),
+                                      o.hide_select) for o in scene.objects}
+    state["collection flags"] = {c.name: (c.hide_render, c.hide_viewport) for c in bpy.data.collections}
+    state["layer collection flags"] = {lc.name: (lc.exclude, lc.hide_viewport)
+                                       for lc in layer.layer_collection.children}
+    state["data"] = {m.name: (len(m.vertices), len(m.polygons), m.users) for m in bpy.data.meshes}
     return state
+
+
+def viewport_hidden_objects(scene):
+    """Hide objects in the viewport in every way that leaves them rendered (the
+    export shows them for the time it reads the scene)."""
+    layer = bpy.context.view_layer
+    scene.objects["Cube"].hide_set(True, view_layer=layer)
+    scene.objects["Wall.Left"].hide_viewport = True
+    coll = bpy.data.collections.new("Hidden in viewport")
+    scene.collection.children.link(coll)
+    coll.objects.link(scene.objects["Wall.Right"])
+    scene.collection.objects.unlink(scene.objects["Wall.Right"])
+    coll.hide_viewport = True
+    layer.layer_collection.children[coll.name].hide_viewport = True
 
 
 class FailingStepsChangeNothing(unittest.TestCase):
@@ -104,6 +159,101 @@ class FailingStepsChangeNothing(unittest.TestCase):
         finally:
             export.export_scene = original
         self.assertEqual(full_state(scene), before)
+
+    def test_half_way_failures_change_nothing(self):
+        """A failure inside a step's loop: some meshes, attributes or lighting copies
+        written, some originals hidden, the rest not."""
+        cases = [
+            ('BOTH', 'BOTH', bake, "build_mesh"),                    # writing meshes
+            ('REFINED', 'LIGHTING', bake_materials, "lighting_copy"),  # their materials
+            ('BOTH', 'REFINED', bake_materials, "add_light_attribute"),  # their attributes
+            ('REFINED', 'BOTH', bake, "set_colour_attribute"),       # attributes of meshes
+            ('BOTH', 'ORIGINAL', bake, "set_colour_attribute"),      # attributes of the originals
+            ('ORIGINAL', 'REFINED', bake.json, "dumps"),             # hiding the originals
+        ]
+        for previous, output, module, name in cases:
+            with self.subTest(previous=previous, output=output, step=name):
+                scene = open_scene("cube")
+                scene.radiosity.output = previous
+                self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
+                before = full_state(scene)
+                scene.radiosity.output = output
+                scene.radiosity.oracle = 'STANDARD'
+                with Patched(module, name, lambda f: failing_at_call(f, 2)):
+                    with self.assertRaisesRegex(RuntimeError, "injected at call 2 of " + name):
+                        bpy.ops.radiosity.solve()
+                self.assertEqual(full_state(scene), before)
+
+    def test_a_failing_export_restores_what_it_showed(self):
+        for failing in (failing_after, lambda f: failing_at_call(f, 1)):
+            scene = open_scene("cube")
+            viewport_hidden_objects(scene)
+            self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
+            before = full_state(scene)
+            with Patched(export, "export_scene", failing):
+                with self.assertRaisesRegex(RuntimeError, "injected"):
+                    bpy.ops.radiosity.solve()
+            self.assertEqual(full_state(scene), before)
+
+    def test_a_failing_or_refused_native_solve_changes_nothing(self):
+        class Failing:
+            """The native module, but its solve (or Scene) raises `error`."""
+            def __init__(self, module, where, error):
+                self.module, self.where, self.error = module, where, error
+
+            def __getattr__(self, name):
+                if name == self.where:
+                    def fail(*args, **kwargs):
+                        raise self.error
+                    return fail
+                return getattr(self.module, name)
+
+        for previous in (None, 'BOTH'):
+            for where, error, message in (("solve", RuntimeError("injected solve failure"), "injected solve"),
+                                          ("solve", MemoryError("injected: too large"), "injected: too large"),
+                                          ("Scene", ValueError("injected: refused"), "injected: refused")):
+                with self.subTest(previous=previous, where=where, error=type(error).__name__):
+                    scene = open_scene("cube")
+                    if previous:
+                        scene.radiosity.output = previous
+                        self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
+                    before = full_state(scene)
+                    with Patched(native, "load", lambda f: lambda: Failing(f(), where, error)):
+                        with self.assertRaisesRegex(RuntimeError, message):
+                            bpy.ops.radiosity.solve()
+                    self.assertEqual(full_state(scene), before)
+
+    def test_cancel_before_the_first_pass_changes_nothing(self):
+        """The interactive path (worker thread, cancel token, conclude) cancelled
+        before the solver completes a pass, with viewport-hidden objects."""
+        class Reports:
+            def __init__(self):
+                self.reports = []
+
+            def report(self, kind, message):
+                self.reports.append((kind, message))
+
+        for previous in (None, 'BOTH', 'LIGHTING'):
+            with self.subTest(previous=previous):
+                scene = open_scene("cube")
+                viewport_hidden_objects(scene)
+                if previous:
+                    scene.radiosity.output = previous
+                    self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
+                before = full_state(scene)
+                solver = native.load()
+                op = Reports()
+                op._finish = lambda context, job: operators.RADIOSITY_OT_solve._finish(op, context, job)
+                job = operators.RADIOSITY_OT_solve._prepare(op, bpy.context, solver)
+                token = solver.CancelToken()
+                token.cancel()
+                worker = threading.Thread(target=operators.RADIOSITY_OT_solve._work, args=(solver, job, token))
+                worker.start()
+                worker.join(120)
+                self.assertFalse(worker.is_alive())
+                self.assertEqual(operators.RADIOSITY_OT_solve._conclude(op, bpy.context, job), {'CANCELLED'})
+                self.assertIn("cancelled before the first pass", op.reports[-1][1])
+                self.assertEqual(full_state(scene), before)
 
     def test_a_solve_that_succeeds_is_not_rolled_back(self):
         scene = open_scene("cube")
