@@ -1,13 +1,14 @@
 """Reads a Blender scene into the solver's arrays (Blender glue; the array work is geometry.py).
 
 What is exported, as a Cycles render would see it:
-- every visible, renderable mesh-like object of the evaluated depsgraph (modifiers
+- every mesh-like object a render shows (render_visibility.py: viewport-hidden
+  ones too, not those disabled in renders) of the evaluated depsgraph (modifiers
   applied), including instances (collection instances, geometry-node and particle
   instances), in world space; polygons as they are (the solver keeps planar quads
-  and triangulates the rest);
+  and triangulates the rest), but faces with a NaN or Inf coordinate left out;
 - per face, the material's diffuse reflectance (Principled BSDF Base Color,
-  Diffuse BSDF Color, the average of an image texture feeding either, else the
-  viewport colour) and emitted radiance (Emission colour x strength of a
+  Diffuse BSDF Color, the average of an image texture feeding either, magenta for
+  one without pixels as in Cycles, else the viewport colour) and emitted radiance (Emission colour x strength of a
   Principled BSDF or an Emission shader);
 - per face corner the UV maps, and each face's loop triangles (how Blender
   renders it), for the UV maps of the refined result (surface_uv.py);
@@ -20,7 +21,8 @@ What is exported, as a Cycles render would see it:
 What is not modelled (node setups other than the above, light node setups,
 textured worlds) or only approximated (a Principled BSDF's metallic or
 transmission read as diffuse, an emission texture's average) is collected in
-`ExportedScene.unmodelled` for one warning.
+`ExportedScene.unmodelled` for one warning; what was left out or replaced
+(non-finite faces, missing images) in `ExportedScene.repaired`.
 """
 
 import math
