@@ -40,10 +40,10 @@ bool TailExtrapolation::after(Hierarchy& h, double residual, bool links_changed)
   last_ratio_ = ratio;
   steady_ = steady ? steady_ + 1 : 0;
   if (wait_ > 0) {
-    --wait_;
+    if (--wait_ == 0 && residual > residual_before_) failed_ = true;
     return false;
   }
-  if (steady_ < kSteadyIterations) return false;
+  if (failed_ || steady_ < kSteadyIterations) return false;
   const double tail = std::min(kMaxTail, ratio / (1.0 - ratio));
   auto& elements = h.elements();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, elements.size()), [&](const auto& range) {
@@ -54,6 +54,7 @@ bool TailExtrapolation::after(Hierarchy& h, double residual, bool links_changed)
   });
   steady_ = 0;
   wait_ = kWaitAfter;
+  residual_before_ = residual;
   last_residual_ = 0.0;  // the next change is not part of the same tail
   return true;
 }

@@ -7,7 +7,11 @@
 // iterations would still add (the geometric tail; Aitken's extrapolation on
 // the whole vector of radiances). It is added once the ratio has held steady,
 // then the iteration carries on, so the result is the converged one whatever
-// the extrapolation got wrong.
+// the extrapolation got wrong. An extrapolation after which the iterations
+// change the radiances more than before it took a mode for the tail that was
+// not (one that alternates in sign, from broken geometry): extrapolating
+// again would feed it, and a bent quad with its reversed copy overflowed
+// (fuzzing), so the rest of the solve iterates plainly.
 #pragma once
 
 #include <vector>
@@ -29,6 +33,8 @@ class TailExtrapolation {
   double last_ratio_ = 0.0, last_residual_ = 0.0;
   int steady_ = 0;   // iterations in a row with a steady ratio
   int wait_ = 0;     // iterations to let pass after an extrapolation
+  double residual_before_ = 0.0;  // of the iteration that extrapolated
+  bool failed_ = false;           // an extrapolation made things worse
 };
 
 }  // namespace radiosity

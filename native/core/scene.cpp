@@ -85,22 +85,78 @@ bool is_convex_planar_quad(std::span<const dvec3> q) {
   return true;
 }
 
-// Ear clipping in the polygon's best-fit plane: Blender's n-gons may be concave.
-std::vector<std::array<size_t, 3>> triangulate(std::span<const dvec3> polygon) {
-  const dvec3 n = glm::normalize(polygon_area_normal(polygon));
+// How far the polygon bends out of its best-fit plane (through the centroid,
+// normal to its area vector), over its diameter.
+double bend(std::span<const dvec3> polygon, const dvec3& normal, double diameter) {
+  dvec3 centroid(0.0);
+  for (const dvec3& v : polygon) centroid += v;
+  centroid /= static_cast<double>(polygon.size());
+  double most = 0.0;
+  for (const dvec3& v : polygon) most = std::max(most, std::abs(glm::dot(normal, v - centroid)));
+  return most / diameter;
+}
+
+// Whether the outline turns somewhere: not all its corners on one line.
+bool turns(std::span<const dvec3> polygon, double diameter) {
+  const size_t n = polygon.size();
+  for (size_t i = 0; i < n; ++i) {
+    const dvec3 turn = glm::cross(polygon[(i + 1) % n] - polygon[i], polygon[(i + 2) % n] - polygon[(i + 1) % n]);
+    if (glm::length(turn) > kDegenerate * diameter * diameter) return true;
+  }
+  return false;
+}
+
+double cross2(dvec2 a, dvec2 b, dvec2 c) { return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x); }
+
+// Whether two edges that share no corner cross or touch, in the plane.
+bool edges_meet(dvec2 a, dvec2 b, dvec2 c, dvec2 d) {
+  const double d1 = cross2(a, b, c), d2 = cross2(a, b, d), d3 = cross2(c, d, a), d4 = cross2(c, d, b);
+  const bool straddle_ab = (d1 > 0) != (d2 > 0) || d1 == 0 || d2 == 0;
+  const bool straddle_cd = (d3 > 0) != (d4 > 0) || d3 == 0 || d4 == 0;
+  return straddle_ab && straddle_cd && std::min(a.x, b.x) <= std::max(c.x, d.x) &&
+         std::min(c.x, d.x) <= std::max(a.x, b.x) && std::min(a.y, b.y) <= std::max(c.y, d.y) &&
+         std::min(c.y, d.y) <= std::max(a.y, b.y);
+}
+
+// Whether the outline crosses or touches itself. Polygons with more corners
+// than this are not checked (the check is quadratic; ear clipping still
+// notices an outline it cannot cut).
+constexpr size_t kMaxCheckedCorners = 256;
+bool self_intersecting(const std::vector<dvec2>& p) {
+  const size_t n = p.size();
+  if (n < 4 || n > kMaxCheckedCorners) return false;
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i + 2; j < n; ++j) {
+      if (i == 0 && j == n - 1) continue;  // neighbours through the last corner
+      if (edges_meet(p[i], p[(i + 1) % n], p[j], p[(j + 1) % n])) return true;
+    }
+  }
+  return false;
+}
+
+// The polygon in coordinates of the plane with unit normal n.
+std::vector<dvec2> project(std::span<const dvec3> polygon, const dvec3& n) {
   const dvec3 helper = std::abs(n.x) < 0.9 ? dvec3(1, 0, 0) : dvec3(0, 1, 0);
   const dvec3 t1 = glm::normalize(glm::cross(helper, n)), t2 = glm::cross(n, t1);
   std::vector<dvec2> p;
   for (const dvec3& v : polygon) p.push_back({glm::dot(v - polygon[0], t1), glm::dot(v - polygon[0], t2)});
-  const auto cross2 = [](dvec2 a, dvec2 b, dvec2 c) {
-    return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-  };
-  std::vector<size_t> remaining(polygon.size());
+  return p;
+}
+
+// Ear clipping in the polygon's best-fit plane: Blender's n-gons may be
+// concave. The first ear tried is at corner 1, so a quad splits along its
+// 0-2 diagonal unless that lies outside it: the triangles Blender draws and
+// Cycles renders for a non-planar quad. Returns false when no ear can be cut:
+// the outline crosses itself.
+bool triangulate(const std::vector<dvec2>& p, std::vector<std::array<size_t, 3>>& triangles) {
+  triangles.clear();
+  std::vector<size_t> remaining(p.size());
   for (size_t i = 0; i < remaining.size(); ++i) remaining[i] = i;
-  std::vector<std::array<size_t, 3>> triangles;
+  size_t start = 1;
   while (remaining.size() > 3) {
     bool clipped = false;
-    for (size_t k = 0; k < remaining.size() && !clipped; ++k) {
+    for (size_t step = 0; step < remaining.size() && !clipped; ++step) {
+      const size_t k = (start + step) % remaining.size();
       const size_t a = remaining[(k + remaining.size() - 1) % remaining.size()];
       const size_t b = remaining[k];
       const size_t c = remaining[(k + 1) % remaining.size()];
@@ -117,17 +173,13 @@ std::vector<std::array<size_t, 3>> triangulate(std::span<const dvec3> polygon) {
       if (contains) continue;
       triangles.push_back({a, b, c});
       remaining.erase(remaining.begin() + static_cast<std::ptrdiff_t>(k));
+      start = k % remaining.size();
       clipped = true;
     }
-    if (!clipped) {  // self-intersecting or degenerate outline: fall back to a fan
-      for (size_t k = 1; k + 1 < remaining.size(); ++k) {
-        triangles.push_back({remaining[0], remaining[k], remaining[k + 1]});
-      }
-      return triangles;
-    }
+    if (!clipped) return false;
   }
   triangles.push_back({remaining[0], remaining[1], remaining[2]});
-  return triangles;
+  return true;
 }
 
 void check_sizes(const SceneArrays& a) {
@@ -244,39 +296,77 @@ Scene make_scene(const SceneArrays& a) {
     fail(m.str());
   }
 
+  // Faces too small to solve in floating point (scene.h).
+  const double smallest_face = std::max(kMinRelativeFaceSize * scene.diameter, kMinFaceSizeOfReach * reach);
   size_t offset = 0;
   std::vector<dvec3> polygon;
+  std::vector<std::array<size_t, 3>> triangles;
   for (size_t f = 0; f < scene.face_count; ++f) {
+    const auto face = static_cast<std::uint32_t>(f);
     const size_t size = static_cast<size_t>(a.face_sizes[f]);
     polygon.clear();
-    for (size_t k = 0; k < size; ++k) polygon.push_back(vertex(a.face_vertices[offset + k]));
+    for (size_t k = 0; k < size; ++k) {
+      const dvec3 v = vertex(a.face_vertices[offset + k]);
+      if (polygon.empty() || v != polygon.back()) polygon.push_back(v);
+    }
     offset += size;
+    while (polygon.size() > 1 && polygon.front() == polygon.back()) polygon.pop_back();
+    const size_t repeated = size - polygon.size();
     PatchBuilder builder{scene,
                          Rgb(a.reflectance[3 * f], a.reflectance[3 * f + 1], a.reflectance[3 * f + 2]),
                          Rgb(a.emission[3 * f], a.emission[3 * f + 1], a.emission[3 * f + 2]),
                          a.two_sided.empty() || a.two_sided[f] != 0, a.occludes.empty() || a.occludes[f] != 0,
-                         static_cast<std::uint32_t>(f)};
+                         face};
     const double diameter = polygon_diameter(polygon);
-    if (!(glm::length(polygon_area_normal(polygon)) > kDegenerate * diameter * diameter)) {
-      scene.skipped.push_back({static_cast<std::uint32_t>(f),
-                               diameter > 0.0 ? "zero area (collinear vertices)"
-                                              : "zero area (coincident vertices)"});
+    const dvec3 area_normal = polygon_area_normal(polygon);
+    if (polygon.size() < 3 || !(glm::length(area_normal) > kDegenerate * diameter * diameter)) {
+      const char* why = !(diameter > 0.0) ? "zero area (coincident vertices)"
+                        : turns(polygon, diameter) ? "its outline crosses itself"  // lobes that cancel
+                                                   : "zero area (collinear vertices)";
+      scene.skipped.push_back({face, why});
       continue;
     }
-    if (size == 3 || (size == 4 && is_convex_planar_quad(polygon))) {
+    if (diameter < smallest_face) {
+      std::ostringstream m;
+      m << "too small to solve (" << diameter << " across, in a scene " << scene.diameter << " across)";
+      scene.skipped.push_back({face, m.str()});
+      continue;
+    }
+    std::ostringstream repairs;
+    if (repeated) repairs << repeated << " repeated corner" << (repeated > 1 ? "s" : "") << " removed; ";
+    if (polygon.size() == 3 || (polygon.size() == 4 && is_convex_planar_quad(polygon))) {
       builder.add(polygon);
     } else {
-      for (const auto& t : triangulate(polygon)) {
+      const dvec3 normal = glm::normalize(area_normal);
+      const std::vector<dvec2> flat = project(polygon, normal);
+      if (self_intersecting(flat) || !triangulate(flat, triangles)) {
+        // A bow-tie has no inside: Blender draws it as triangles that overlap,
+        // facing opposite ways, and each would send its light twice.
+        scene.skipped.push_back({face, "its outline crosses itself"});
+        continue;
+      }
+      for (const auto& t : triangles) {
         const dvec3 tri[3] = {polygon[t[0]], polygon[t[1]], polygon[t[2]]};
         builder.add(tri);
       }
+      const double bent = bend(polygon, normal, diameter);
+      if (bent > kPlanar) {
+        repairs << "not planar (bends by " << 100.0 * bent << " % of its size): split into " << builder.made
+                << " planar triangles; ";
+      }
     }
     if (builder.made == 0) {
-      scene.skipped.push_back({static_cast<std::uint32_t>(f), "degenerate after triangulation"});
+      scene.skipped.push_back({face, "degenerate after triangulation"});
+      continue;
+    }
+    std::string repaired = repairs.str();
+    if (!repaired.empty()) {
+      repaired.resize(repaired.size() - 2);
+      scene.repaired.push_back({face, repaired});
     }
   }
   if (scene.patches.empty()) {
-    fail("every face is degenerate (zero area); nothing to solve");
+    fail("every face is degenerate or broken and was skipped (face " + std::to_string(scene.skipped.front().face) + ": " + scene.skipped.front().what + "); nothing to solve");
   }
   mesh_contacts(scene);
   for (const Patch& p : scene.patches) {

@@ -1,7 +1,9 @@
 // The scene the solver sees: input faces checked and turned into planar patches
 // (quads kept when planar and convex, other polygons triangulated), each with
 // its reflectance, emission and sidedness. Degenerate faces are skipped with a
-// reason; malformed input is rejected with a message naming the problem.
+// reason; broken but common ones (repeated corners, non-planar or
+// self-crossing outlines) are repaired and listed; malformed input is
+// rejected with a message naming the problem.
 #pragma once
 
 #include <array>
@@ -27,6 +29,13 @@ inline constexpr double kMaxInputRadiance = 1e30;
 inline constexpr double kMaxCoordinate = 1e30;
 inline constexpr double kMinSceneSize = 1e-6;
 inline constexpr double kMinRelativeSize = 1e-6;
+// Faces smaller than kMinRelativeFaceSize of the scene's diameter, or than
+// kMinFaceSizeOfReach of its distance from the origin, are skipped: their
+// light is at most the square of that of the scene's, and at such sizes the
+// sample offsets (hierarchy.h) vanish in rounding (a 3e-13 face in a 20 m
+// room made NaN, fuzzing).
+inline constexpr double kMinRelativeFaceSize = 1e-7;
+inline constexpr double kMinFaceSizeOfReach = 1e-9;
 
 // Views on the caller's arrays (numpy, without copies).
 struct SceneArrays {
@@ -82,9 +91,10 @@ struct Patch {
   std::array<float, 4> edge_inset{};  // edge k runs from corner k to k + 1
 };
 
-struct SkippedFace {
+// An input face left out (why), or solved after a repair (what was done).
+struct FaceNote {
   std::uint32_t face;
-  std::string reason;
+  std::string what;
 };
 
 struct Scene {
@@ -93,7 +103,10 @@ struct Scene {
   // them (a cut line must not be a crack light can slip through), without
   // those merged into a coinciding face.
   std::vector<Patch> occluders;
-  std::vector<SkippedFace> skipped;
+  std::vector<FaceNote> skipped;
+  // Faces solved after a repair: repeated corners removed, non-planar or
+  // self-crossing outlines split into triangles (with how far they bend).
+  std::vector<FaceNote> repaired;
   // Direct light that is not a surface: the scene's lights, then the sky when
   // the world is not black (lights.h, direct_light.h).
   std::vector<Light> lights;

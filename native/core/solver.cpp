@@ -726,6 +726,7 @@ SolveResult Solver::run() {
   stats_.cluster_links = cluster_links_.size();
   stats_.light_links = light_links_.size();
   stats_.skipped_faces = scene_.skipped.size();
+  stats_.repaired_faces = scene_.repaired.size();
   track_memory();
   stats_.seconds = elapsed();
   result_.stats = stats_;

@@ -92,6 +92,7 @@ struct SolveStats {
   double residual = 0.0;     // relative change of the last iteration
   double threshold = 0.0;    // of the last complete pass
   std::size_t skipped_faces = 0;
+  std::size_t repaired_faces = 0;  // solved after a repair (Scene::repaired)
   bool cancelled = false;
   std::string stopped_by;    // "quality", "max_elements", "memory", "time_budget", "cancel"
   double seconds = 0.0;

@@ -178,6 +178,7 @@ py::dict stats_dict(const SolveStats& s) {
   d["residual"] = s.residual;
   d["threshold"] = s.threshold;
   d["skipped_faces"] = s.skipped_faces;
+  d["repaired_faces"] = s.repaired_faces;
   d["cancelled"] = s.cancelled;
   d["stopped_by"] = s.stopped_by;
   d["seconds"] = s.seconds;
@@ -360,7 +361,8 @@ void bind_solver(py::module_& m) {
                     "'cos_half_angle', 'blend_width', 'cosine_falloff'} or {'type': 'sun', 'direction' (the way\n"
                     "its light travels), 'irradiance' (H facing it), 'angle' (radians)}; world (3,): the radiance of\n"
                     "a uniform world, light from every direction that leaves the scene.\n"
-                    "Degenerate faces are skipped and listed in skipped_faces; bad input raises ValueError.")
+                    "Degenerate faces are skipped (skipped_faces), broken ones repaired (repaired_faces); bad input\n"
+                    "raises ValueError.")
       .def(py::init(&make_python_scene), py::arg("positions"), py::arg("face_vertices"),
            py::arg("face_sizes"), py::arg("reflectance"), py::arg("emission"),
            py::arg("two_sided") = py::none(), py::arg("occludes") = py::none(), py::arg("lights") = py::none(),
@@ -372,9 +374,15 @@ void bind_solver(py::module_& m) {
                              "lights solved as direct light: point, spot and sun lights, and the sky")
       .def_property_readonly("skipped_faces", [](const Scene& s) {
         py::list out;
-        for (const auto& k : s.skipped) out.append(py::make_tuple(k.face, k.reason));
+        for (const auto& k : s.skipped) out.append(py::make_tuple(k.face, k.what));
         return out;
-      })
+      }, "(face, reason) of the input faces left out: zero area, or too small to solve")
+      .def_property_readonly("repaired_faces", [](const Scene& s) {
+        py::list out;
+        for (const auto& k : s.repaired) out.append(py::make_tuple(k.face, k.what));
+        return out;
+      }, "(face, what was done) of the input faces solved after a repair: repeated corners removed,\n"
+         "non-planar or self-crossing outlines split into triangles")
       .def_property_readonly("coincident_faces", [](const Scene& s) {
         py::list out;
         for (const auto& pair : s.coincident) out.append(py::make_tuple(pair[0], pair[1]));

@@ -103,7 +103,8 @@ def folded_quad_scene():
     wing BCD, and a comb of 40 small triangles between them, so that the links'
     shafts hold more than 32 candidates and sampled visibility goes through Embree."""
     b = SceneBuilder()
-    corners = [(0, 0, 1.5), (2, 0, 0), (2, 2, 1.5), (0, 2, 0)]   # A, B, C, D
+    # B first: a quad splits along its 0-2 diagonal (as Blender splits it).
+    corners = [(2, 0, 0), (2, 2, 1.5), (0, 2, 0), (0, 0, 1.5)]   # B, C, D, A
     fold = b.polygon(corners, rho=0.5, two_sided=False)
     centre = np.array([3.2, 3.2, 1.2])
     facing = -np.array([1.0, 1.0, 0.2]) / np.linalg.norm([1.0, 1.0, 0.2])

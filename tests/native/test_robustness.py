@@ -4,6 +4,7 @@ MemoryError, never a crash, a NaN or a hang; budgets are kept.
 """
 
 import pathlib
+import re
 import sys
 import time
 import unittest
@@ -100,6 +101,89 @@ class BrokenPolygons(unittest.TestCase):
         self.assertIn(len(b.faces) - 2, skipped)  # [n, n, n]: coincident corners
         self.assertRegex(skipped[len(b.faces) - 2], "zero area")
         assert_finite(self, rad.solve(scene, quality=0.5))
+
+
+    def test_a_non_planar_quad_is_split_as_blender_splits_it_and_its_bend_is_named(self):
+        # A quad with one corner lifted by 0.2.
+        b, _ = open_room(0)
+        face = b.polygon([(1, 1, 1), (2, 1, 1), (2, 2, 1.2), (1, 2, 1)], rho=0.5)
+        scene = b.scene(rad)
+        repaired = dict(scene.repaired_faces)
+        self.assertEqual(set(repaired), {face})
+        # The bend: the corners' largest distance from the plane through their
+        # centroid normal to the area vector, over the diameter.
+        q = np.array([(1, 1, 1), (2, 1, 1), (2, 2, 1.2), (1, 2, 1)], float)
+        normal = np.cross(q[2] - q[0], q[3] - q[1])
+        normal /= np.linalg.norm(normal)
+        expected = np.max(np.abs((q - q.mean(axis=0)) @ normal)) / np.linalg.norm(q[2] - q[0])
+        bend = float(re.search(r"bends by ([0-9.]+) %", repaired[face]).group(1))
+        self.assertAlmostEqual(bend, 100 * expected, delta=1e-4)
+        self.assertIn("split into 2 planar triangles", repaired[face])
+        # Blender splits along the 0-2 diagonal: both triangles hold corners 0 and 2.
+        pieces = [p for p in scene.patches if p["sides"][0] and p["sides"][0][0] == face]
+        self.assertEqual(len(pieces), 2)
+        for piece in pieces:
+            corners = {tuple(np.round(c, 9)) for c in piece["corners"]}
+            self.assertTrue({(1.0, 1.0, 1.0), (2.0, 2.0, 1.2)} <= corners, corners)
+        self.assertEqual(rad.solve(scene, quality=0.3).stats["repaired_faces"], 1)
+
+    def test_repeated_corners_are_removed_and_named(self):
+        b, _ = open_room(0)
+        n = len(b.positions)
+        face = b.polygon([(1, 1, 1), (2, 1, 1), (2, 1, 1), (2, 2, 1), (1, 2, 1)], rho=0.5)
+        b.faces[face] = [n, n + 1, n + 2, n + 3, n + 4, n]  # a repeated index too
+        scene = b.scene(rad)
+        self.assertRegex(dict(scene.repaired_faces)[face], "^2 repeated corners removed$")
+        self.assertEqual(len([p for p in scene.patches if p["sides"][0] and p["sides"][0][0] == face]), 1,
+                         "solved as the planar quad it is")
+
+    def test_a_bow_tie_is_skipped_with_its_reason_and_the_rest_solves(self):
+        b, _ = open_room(0)
+        face = b.polygon([(1, 1, 1), (2, 2, 1), (2, 1, 1), (1, 2, 1)], rho=0.5)
+        scene = b.scene(rad)
+        self.assertEqual(dict(scene.skipped_faces)[face], "its outline crosses itself")
+        result = rad.solve(scene, quality=0.3)
+        assert_finite(self, result)
+        self.assertNotIn(face, set(np.asarray(result.source_face)))
+
+    def test_a_face_too_small_for_floating_point_is_skipped(self):
+        # Fuzzing (generator seed 594270769): a 3e-13 quad 1 m from a wall of
+        # a 20 m scene, under a white world, made the wall NaN.
+        b = SceneBuilder()
+        b.polygon([(-7.05, -10.6, -6.46), (-7.05, 7.09, -6.46), (-7.05, 7.09, 7.25), (-7.05, -10.6, 7.25)],
+                  rho=0.8, emission=2.0)
+        corner = np.array([-6.051289913666132, -2.401285793458587, 1.8345027129815215])
+        offsets = [(0, 0, 0), (5.17e-13, 2.64e-13, 5.76e-13), (5.2e-13, 2.86e-13, 6.02e-13), (4.66e-13, 5.1e-13, 8.15e-13)]
+        tiny = b.polygon([corner + o for o in offsets], rho=0.6, emission=1.0)
+        b.polygon([(3.59, 4.06, 6.12), (3.59, 10.8, 6.12), (3.59, 10.8, 4.1), (3.59, 4.06, 4.1)], rho=0.2, emission=1.0)
+        a = b.arrays()
+        scene = rad.Scene(a["positions"], a["face_vertices"], a["face_sizes"], a["reflectance"], a["emission"],
+                          a["two_sided"], world=np.array([40.7, 50.2, 6.9]))
+        self.assertRegex(dict(scene.skipped_faces)[tiny], "^too small to solve")
+        for oracle in ORACLES:
+            assert_finite(self, rad.solve(scene, oracle=oracle, quality=0.0, leaf_links="all"))
+
+    def test_a_bent_quad_and_its_reversed_copy_converge(self):
+        # Fuzzing (atheris): one non-planar quad twice, the second reversed,
+        # under a white world: the four triangles close a tetrahedron 2e6
+        # across whose inside reflects 0.9. The radiances overflowed (an
+        # extrapolation fed a mode that alternates in sign).
+        positions = np.array([[443137.2549019567, 443137.2549019608, 443137.2549019608],
+                              [-685718.5091357678, 289062.499996362, -994869.1125027839],
+                              [-999992.2577189296, 898039.2156845483, -992187.5771353545],
+                              [-294117.686804384, 312500.4000030458, 999969.3636859774]])
+        scene = rad.Scene(positions, np.array([3, 0, 2, 1, 1, 2, 0, 3]), np.array([4, 4]), np.full((2, 3), 0.9),
+                          np.zeros((2, 3)), world=np.array([2.9, 10.0, 9.0]))
+        self.assertEqual(len(scene.repaired_faces), 2)
+        for options in (dict(quality=0.21, leaf_links="all", max_elements=161), dict(quality=0.0),
+                        dict(quality=0.21, visibility="sampled")):
+            with self.subTest(**options):
+                result = rad.solve(scene, **options)
+                assert_finite(self, result)
+                # Inside and out, nothing exceeds what a closed surface of
+                # reflectance 0.9 lit by the world can reach: 10 / (1 - 0.9).
+                self.assertLess(float(np.max(result.radiance)), 100.0)
+                self.assertLess(result.stats["residual"], 1e-3)
 
 
 class OutOfRange(unittest.TestCase):
