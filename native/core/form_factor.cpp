@@ -63,10 +63,19 @@ class PolygonBuffer {
   std::vector<Vertex> heap_;
 };
 
-// Receiver strictly in front of the polygon's plane. The normal comes from edges
-// relative to v0 (Newell's method on absolute coordinates fails for tiny, distant
-// polygons). "On the plane" allows for the rounding of the coordinates and a
-// tiny fraction of the polygon's size (MATH.md s3), so a receiver 1e-9 of the
+// Receiver strictly in front of the polygon: above its plane by more than
+// every vertex is, and by more than the polygon's own thickness (a polygon
+// planar to 1e-9 of its size may have a corner 6e-9 long twisted by 30
+// degrees; from 3e-10 above it F was -6.5e-4: libFuzzer kernels, crash-dd8d717d). The normal comes from edges relative to v0 (Newell's method
+// on absolute coordinates fails for tiny, distant polygons). Heights are
+// measured the same way for the receiver and for the vertices, so what the
+// normal gets wrong (its direction is only good to about eps / sin of the
+// polygon's sharpest fan angle: a sliver triangle 1e-5 wide tilts it by 1e-11)
+// and what a nearly planar polygon leaves off its plane move both alike: a
+// receiver on a vertex is never in front of it (a receiver on a vertex of a
+// sliver, 1e-10 "in front" of v0's plane, gave F = -0.54; atheris finding 1).
+// "On the plane" also allows for the rounding of the coordinates and a tiny
+// fraction of the polygon's size (MATH.md s3), so a receiver 1e-9 of the
 // emitter's size away still sees it.
 template <class Vertex>
 bool receiver_in_front(const dvec3& r, std::span<const Vertex> polygon) {
@@ -82,9 +91,16 @@ bool receiver_in_front(const dvec3& r, std::span<const Vertex> polygon) {
   diameter = std::max(diameter, glm::length(position_of(polygon.back()) - v0));
   const double twice_area = glm::length(area_normal);
   if (!(twice_area > 0.0)) return false;
-  const double height = glm::dot(area_normal / twice_area, r - v0);
+  const dvec3 normal = area_normal / twice_area;
+  double top = 0.0, bottom = 0.0;  // v0's height is 0
+  for (size_t i = 1; i < polygon.size(); ++i) {
+    const double h = glm::dot(normal, position_of(polygon[i]) - v0);
+    top = std::max(top, h);
+    bottom = std::min(bottom, h);
+  }
+  const double height = glm::dot(normal, r - v0);
   const double rounding = 1e-15 * (glm::length(r) + glm::length(v0));
-  return height > 1e-12 * diameter + rounding;
+  return height > top + (top - bottom) + 1e-12 * diameter + rounding;
 }
 
 // Height of a vertex above the receiver's horizon; a vertex below it only by
@@ -155,10 +171,42 @@ FormFactorGradient finite_or_zero(const FormFactorGradient& result) {
   return finite ? result : FormFactorGradient{};
 }
 
+// F is dimensionless, but the edge terms hold products of up to four lengths
+// (|c|^2, s^2 + d^2): below about 1e-77 they underflow (F = -0.24 instead of
+// 0.21 for a polygon 4e-81 across; libFuzzer kernels, crash-8fd16867) and
+// above about 1e77 they overflow. Such input is moved to r = 0 and scaled by
+// a power of two to unit size, where it is evaluated; within that range
+// nothing changes (a power-of-two scale is exact, so even there the result
+// would be the same bits but for the move). `scale` is 0 when no rescaling is
+// needed.
+struct Rescaled {
+  PolygonBuffer<dvec3> polygon;
+  double scale = 0.0;
+  explicit Rescaled(size_t n) : polygon(n) {}
+};
+
+Rescaled rescale(const dvec3& r, std::span<const dvec3> polygon) {
+  Rescaled out(polygon.size());
+  double extent = 0.0;
+  for (const dvec3& v : polygon) {
+    const dvec3 d = glm::abs(v - r);
+    extent = std::max(extent, std::max(d.x, std::max(d.y, d.z)));
+  }
+  constexpr double kLow = 0x1p-200, kHigh = 0x1p+200;
+  if (!(extent > 0.0) || !std::isfinite(extent) || (extent >= kLow && extent <= kHigh)) return out;
+  out.scale = std::ldexp(1.0, -std::ilogb(extent));
+  for (size_t i = 0; i < polygon.size(); ++i) out.polygon.data()[i] = (polygon[i] - r) * out.scale;
+  return out;
+}
+
 }  // namespace
 
 double form_factor(const dvec3& r, const dvec3& n, std::span<const dvec3> polygon) {
-  if (polygon.size() < 3 || !receiver_in_front(r, polygon)) return 0.0;
+  if (polygon.size() < 3) return 0.0;
+  if (Rescaled moved = rescale(r, polygon); moved.scale != 0.0) {
+    return form_factor(dvec3(0.0), n, std::span<const dvec3>(moved.polygon.data(), polygon.size()));
+  }
+  if (!receiver_in_front(r, polygon)) return 0.0;
   const double value = with_horizon_clip(r, n, polygon, [&](std::span<const dvec3> poly) {
     double sum = 0.0;
     const size_t size = poly.size();
@@ -174,7 +222,15 @@ double form_factor(const dvec3& r, const dvec3& n, std::span<const dvec3> polygo
 
 FormFactorGradient form_factor_gradient(const dvec3& r, const dvec3& n,
                                         std::span<const dvec3> polygon) {
-  if (polygon.size() < 3 || !receiver_in_front(r, polygon)) return {};
+  if (polygon.size() < 3) return {};
+  if (Rescaled moved = rescale(r, polygon); moved.scale != 0.0) {
+    // r' = (r - r0) scale: dF/dr = scale dF/dr'.
+    FormFactorGradient g =
+        form_factor_gradient(dvec3(0.0), n, std::span<const dvec3>(moved.polygon.data(), polygon.size()));
+    g.gradient *= moved.scale;
+    return finite_or_zero(g);
+  }
+  if (!receiver_in_front(r, polygon)) return {};
   return finite_or_zero(with_horizon_clip(r, n, polygon, [&](std::span<const dvec3> poly) {
     // grad F = 1/2pi sum [g_i grad theta_i + theta_i grad g_i], finite where an edge
     // subtends 90 degrees (the printed edge matrix divides by a.b there).

@@ -6,7 +6,11 @@
 //    normal. A receiver behind the emitter or on its plane sees F = 0.
 //  - The polygon is clipped to the receiver's upper half-space before integration.
 //  - Results are always finite; degenerate input (zero-area polygons, non-finite
-//    values) is rejected upstream, never turned into NaN here.
+//    values, coordinates beyond kMaxCoordinate of core/scene.h) is rejected
+//    upstream, never turned into NaN here.
+//  - "In front" means above the emitter's plane by more than every vertex is,
+//    plus a tiny fraction of its size: a receiver on a vertex, an edge or the
+//    polygon itself sees F = 0, however thin the polygon.
 #pragma once
 
 #include <span>

@@ -449,9 +449,16 @@ bool setup(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter, Works
   w.size = diameter(emitter);
   w.height_r = w.frame.height(r);
   // Receiver on or behind the emitter plane sees nothing (MATH.md section 3),
-  // with the threshold of form_factor.cpp so the two agree on what is visible.
+  // with the rule of form_factor.cpp (receiver_in_front: above every vertex,
+  // by more than the emitter's thickness)
+  // so the two agree on what is visible.
+  double top = 0.0, bottom = 0.0;
+  for (const dvec3& v : emitter) {
+    top = std::max(top, w.frame.height(v));
+    bottom = std::min(bottom, w.frame.height(v));
+  }
   const double rounding = 1e-15 * (glm::length(r) + glm::length(w.frame.origin));
-  if (!(w.height_r > 1e-12 * w.size + rounding)) return false;
+  if (!(w.height_r > top + (top - bottom) + 1e-12 * w.size + rounding)) return false;
   w.tol.plane = 1e-11 * w.size;
   w.tol.space = 1e-11 * std::max(w.size, glm::length(r - w.frame.origin));
   w.tol.area = 1e-22 * w.size * w.size;

@@ -23,7 +23,9 @@
 // emitter plane), apparent otherwise (lines s and t, eq. 14).
 //
 // Tolerances are relative to the emitter's size and the point's distance, so the
-// result does not change when the scene is scaled.
+// result does not change when the scene is scaled. Domain: coordinates within
+// kMaxCoordinate (core/scene.h), as a scene's are; the bindings refuse others
+// (products of four lengths of 1e154 overflow: NaN anchors).
 #pragma once
 
 #include <span>

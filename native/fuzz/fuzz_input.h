@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/form_factor.h"
+#include "core/scene.h"
 #include "core/visible_polygon.h"
 #include "core/vec.h"
 
@@ -68,12 +69,18 @@ inline void require_finite(const dvec3& v, const char* what) {
 
 inline bool finite(const dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-// python/numpy_input.cpp, read_polygon: at least 3 finite vertices, not of zero area.
+// python/numpy_input.cpp, require_coordinates: finite and within
+// kMaxCoordinate, as a point, polygon or occluder of the kernels must be.
+inline bool in_range(const dvec3& v) {
+  return std::abs(v.x) <= kMaxCoordinate && std::abs(v.y) <= kMaxCoordinate && std::abs(v.z) <= kMaxCoordinate;
+}
+
+// python/numpy_input.cpp, read_polygon: at least 3 vertices within range, not of zero area.
 inline bool valid_polygon(std::span<const dvec3> polygon) {
   const std::size_t n = polygon.size();
   if (n < 3) return false;
   for (const dvec3& v : polygon)
-    if (!finite(v)) return false;
+    if (!in_range(v)) return false;
   dvec3 area_normal(0.0);
   double diameter = 0.0;
   for (std::size_t i = 1; i + 1 < n; ++i)

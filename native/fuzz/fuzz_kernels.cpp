@@ -27,7 +27,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   // As _radiosity.form_factor() and form_factor_gradient() call them.
   dvec3 normal;
-  if (fuzz::finite(point) && fuzz::unit_normal(raw_normal, normal) && fuzz::valid_polygon(p)) {
+  if (fuzz::in_range(point) && fuzz::unit_normal(raw_normal, normal) && fuzz::valid_polygon(p)) {
     // To a planar convex polygon (what the solver passes) F is a share of the
     // hemisphere; the kernels take any polygon, whose F must only be finite.
     const bool bounded = fuzz::planar_convex(p);

@@ -4,7 +4,8 @@
 // triangles at once (visible_form_factor_gradient_parts, as a split emitter is
 // evaluated). The emitter, point and normal pass the checks the Python
 // bindings make (visible_polygon(), visible_form_factor()); occluders are any
-// finite triangles. Findings: a sanitizer report, a non-finite value, a hang.
+// triangles within kMaxCoordinate (core/scene.h), as the bindings take them.
+// Findings: a sanitizer report, a non-finite value, a hang.
 //
 // Input: u8 flags; point; normal; emitter (fuzz_input.h, read_polygon); u16
 // occluder count (at most 48); per occluder u8 kind and its vertices (kind 0:
@@ -41,8 +42,8 @@ std::vector<Triangle> read_occluders(fuzz::Reader& in, const dvec3& point, std::
       if (kind == 3) tri.v[0] = emitter[in.u8() % emitter.size()];
     }
     bool ok = true;
-    for (const dvec3& v : tri.v) ok = ok && fuzz::finite(v);
-    if (ok) out.push_back(tri);  // the bindings refuse non-finite occluders
+    for (const dvec3& v : tri.v) ok = ok && fuzz::in_range(v);
+    if (ok) out.push_back(tri);  // the bindings refuse occluders out of range
   }
   return out;
 }
@@ -56,7 +57,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   dvec3 normal;
   const bool normal_ok = fuzz::unit_normal(in.vec3(), normal);
   const std::vector<dvec3> emitter = fuzz::read_polygon(in, 12);
-  if (!normal_ok || !fuzz::finite(point) || !fuzz::valid_polygon(emitter) || !fuzz::planar_convex(emitter))
+  if (!normal_ok || !fuzz::in_range(point) || !fuzz::valid_polygon(emitter) || !fuzz::planar_convex(emitter))
     return 0;
   const std::vector<Triangle> occluders = read_occluders(in, point, emitter);
 

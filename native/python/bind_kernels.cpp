@@ -24,7 +24,7 @@ struct KernelInput {
 KernelInput read_kernel_input(const py::handle& point, const py::handle& normal,
                               const py::handle& polygon) {
   KernelInput in;
-  in.point = read_vec3(point, "point");
+  in.point = read_point(point, "point");
   in.normal = read_unit_vec3(normal, "normal");
   in.polygon = read_polygon(polygon, "polygon");
   return in;

@@ -39,6 +39,7 @@ std::vector<Triangle> read_triangles(const py::handle& object, const std::string
     return {};
   const auto a = read_array(object, name, {-1, 3, 3});
   const auto m = static_cast<std::size_t>(a.shape(0));
+  require_coordinates(a.data(), 9 * m, name);
   std::vector<Triangle> triangles(m);
   const double* p = a.data();
   for (std::size_t t = 0; t < m; ++t)
@@ -93,7 +94,7 @@ void bind_visibility(py::module_& m) {
       [](const py::handle& point, const py::handle& normal, const py::handle& emitter,
          const py::handle& occluders, const std::string& mode, int rays, const py::handle& faces,
          const py::handle& own_faces) {
-        const dvec3 r = read_vec3(point, "point");
+        const dvec3 r = read_point(point, "point");
         const dvec3 n = read_unit_vec3(normal, "normal");
         const std::vector<dvec3> polygon = read_polygon(emitter, "emitter");
         require_planar_convex(polygon, "emitter");
@@ -139,7 +140,7 @@ void bind_visibility(py::module_& m) {
       "visible_polygon",
       [](const py::handle& point, const py::handle& normal, const py::handle& emitter,
          const py::handle& occluders) {
-        const dvec3 r = read_vec3(point, "point");
+        const dvec3 r = read_point(point, "point");
         const dvec3 n = read_unit_vec3(normal, "normal");
         const std::vector<dvec3> polygon = read_polygon(emitter, "emitter");
         require_planar_convex(polygon, "emitter");

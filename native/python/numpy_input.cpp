@@ -4,6 +4,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/scene.h"
+
 namespace py = pybind11;
 
 namespace radiosity::python {
@@ -62,6 +64,23 @@ dvec3 read_vec3(const py::handle& object, const std::string& name) {
   return {a.at(0), a.at(1), a.at(2)};
 }
 
+void require_coordinates(const double* data, size_t count, const std::string& name) {
+  for (size_t i = 0; i < count; ++i) {
+    if (!(std::abs(data[i]) <= kMaxCoordinate)) {
+      std::ostringstream message;
+      message << name << " has a coordinate of magnitude " << std::abs(data[i]) << " at flat index " << i
+              << ", beyond the " << kMaxCoordinate << " a scene may have";
+      throw std::invalid_argument(message.str());
+    }
+  }
+}
+
+dvec3 read_point(const py::handle& object, const std::string& name) {
+  const auto a = read_array(object, name, {3});
+  require_coordinates(a.data(), 3, name);
+  return {a.at(0), a.at(1), a.at(2)};
+}
+
 dvec3 read_unit_vec3(const py::handle& object, const std::string& name) {
   const dvec3 v = read_vec3(object, name);
   const double length = glm::length(v);
@@ -77,6 +96,7 @@ std::vector<dvec3> read_polygon(const py::handle& object, const std::string& nam
   if (n < 3) {
     throw std::invalid_argument(name + " needs at least 3 vertices, got " + std::to_string(n));
   }
+  require_coordinates(a.data(), 3 * n, name);
   std::vector<dvec3> polygon(n);
   const double* p = a.data();
   for (size_t i = 0; i < n; ++i) polygon[i] = {p[3 * i], p[3 * i + 1], p[3 * i + 2]};

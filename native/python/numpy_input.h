@@ -45,10 +45,18 @@ InputArray<double> read_array(const pybind11::handle& object, const std::string&
 // Throws if any value of the array is NaN or infinite.
 void require_finite(const double* data, size_t count, const std::string& name);
 
+// Throws if any value's magnitude exceeds kMaxCoordinate (core/scene.h): the
+// kernels take points, polygons and occluders in the range a scene may have
+// (their products of four lengths overflow near 1e77, and beyond 1e154 the
+// visible-polygon code made NaN; libFuzzer visible_polygon, crash-516ec420).
+void require_coordinates(const double* data, size_t count, const std::string& name);
+
 dvec3 read_vec3(const pybind11::handle& object, const std::string& name);
+// A point of the kernels: finite and within kMaxCoordinate.
+dvec3 read_point(const pybind11::handle& object, const std::string& name);
 dvec3 read_unit_vec3(const pybind11::handle& object, const std::string& name);
 
-// A planar polygon (n, 3), n >= 3, finite, with non-zero area.
+// A polygon (n, 3), n >= 3, finite, within kMaxCoordinate, with non-zero area.
 std::vector<dvec3> read_polygon(const pybind11::handle& object, const std::string& name);
 
 pybind11::array_t<double> to_numpy(const dvec3& v);

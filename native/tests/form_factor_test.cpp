@@ -311,6 +311,88 @@ TEST(FormFactorExtremes, SizeOverDistanceFrom1e9To1e9) {
   }
 }
 
+TEST(FormFactorExtremes, ScaleFrom1e100To1e100) {
+  // The edge terms hold products of four lengths, which underflowed below
+  // about 1e-77 (F = -0.24 for a polygon 4e-81 across, libFuzzer kernels
+  // crash-8fd16867) and overflow above about 1e77: such input is rescaled.
+  const double reference = 0.13853160599489298;
+  for (double s = 1e-100; s <= 1e100; s *= 1e10) {
+    const auto quad = rectangle_facing_down(0, s, 0, s, s);
+    EXPECT_NEAR(form_factor(dvec3(0), kUp, quad), reference, 1e-12 * reference) << "scale " << s;
+    const auto [value, gradient] = form_factor_gradient(dvec3(0), kUp, quad);
+    EXPECT_NEAR(value, reference, 1e-12 * reference) << "scale " << s;
+    expect_vec_near(gradient * s, {0.143418746198575, 0.143418746198575, 0.122317450694745}, 1e-11);
+  }
+  // The fuzzer's 14-gon, 4e-81 across, seen from 6e-9 of its size above it:
+  // the same F as scaled by 2^268 (exact) to unit size, and that one is the
+  // limit of a receiver on a plane, tilted by beta from facing it, that the
+  // emitter all but fills: (1 - cos beta) / 2 (the plane's part of the
+  // hemisphere; cubature does not converge this close to the emitter).
+  const std::vector<dvec3> tiny = {
+      {2.2238036002151056e-81, 6.9709482627161094e-84, 2.0549185278933649e-81},
+      {3.2319079304955273e-81, 3.7066964068998719e-82, 2.0547553399032966e-81},
+      {3.7611076748717400e-81, 9.1017432135807313e-82, 2.0546282081473424e-81},
+      {4.0887086236281565e-81, 1.7639021879165663e-81, 2.0544876787332867e-81},
+      {4.0134482386102686e-81, 2.6752251471732768e-81, 2.0543882217640257e-81},
+      {3.5502327620789191e-81, 3.4636445104047843e-81, 2.0543495359120816e-81},
+      {2.7908077001261476e-81, 3.9730041533941504e-81, 2.0543792833848825e-81},
+      {1.8855865000088713e-81, 4.1024191519612603e-81, 2.0544715723306115e-81},
+      {1.0138593222197791e-81, 3.8262572784691004e-81, 2.0546081237917173e-81},
+      {3.4828242535223661e-82, 3.1992157788659031e-81, 2.0547618920766340e-81},
+      {2.0681476595819890e-83, 2.3454879123074099e-81, 2.0549024214906897e-81},
+      {9.5941861613707862e-83, 1.4341649530506996e-81, 2.0550018784599507e-81},
+      {5.5915733814505661e-82, 6.4574558981919306e-82, 2.0550405643118948e-81},
+      {1.3185824000978293e-81, 1.3638594682982606e-82, 2.0550108168390939e-81}};
+  const dvec3 r(2.0549049897155772e-81, 2.0546950501119882e-81, 2.0546950501119882e-81);
+  const dvec3 n = glm::normalize(dvec3(1.0));
+  std::vector<dvec3> unit;
+  for (const dvec3& v : tiny) unit.push_back(v * 0x1p268);
+  const double f = form_factor(r, n, tiny);
+  const double f_unit = form_factor(r * 0x1p268, n, unit);
+  EXPECT_NEAR(f, f_unit, 1e-12);
+  dvec3 area(0.0);
+  for (size_t i = 1; i + 1 < unit.size(); ++i) area += glm::cross(unit[i] - unit[0], unit[i + 1] - unit[0]);
+  EXPECT_NEAR(f_unit, 0.5 * (1.0 - glm::dot(n, glm::normalize(area))), 1e-6);
+}
+
+TEST(FormFactorExtremes, ReceiverOnAVertexOfASliverSeesNothing) {
+  // A triangle 19 long and 2e-4 wide; its normal from the long edges is off
+  // by 1e-11, which put a receiver on vertex 2 2e-11 "in front" of v0's
+  // plane: F = -0.033 (atheris, finding 1; 109 findings in a 600 s run).
+  const std::vector<dvec3> sliver = {{9.99938964836474, -9.842458791099524, -9.99999999941564},
+                                     {2.8625488677062094, 2.862745098039216, 2.862745098039216},
+                                     {2.862745098039216, 2.862745098039216, 2.862745098039216}};
+  const dvec3 n = glm::normalize(dvec3(-9.999999999999954, -7.490196078431373, -10.0));
+  for (const dvec3& r : {sliver[2], dvec3(2.862745098039219, 2.8627450980392064, 2.862745098039214)}) {
+    EXPECT_EQ(form_factor(r, n, sliver), 0.0);
+    EXPECT_EQ(form_factor_gradient(r, n, sliver).value, 0.0);
+    EXPECT_EQ(form_factor_gradient(r, n, as_contour(sliver)).value, 0.0);
+  }
+  // Just off the vertex, in front (1e-3 along the normal, facing the
+  // triangle), F is positive and the sum over the sliver's two halves.
+  const dvec3 normal = glm::normalize(glm::cross(sliver[2] - sliver[1], sliver[0] - sliver[1]));
+  const dvec3 r = sliver[2] + 1e-3 * normal - 1e-3 * glm::normalize(sliver[2] - sliver[0]);
+  const dvec3 middle = 0.5 * (sliver[0] + sliver[1]);
+  const double f = form_factor(r, -normal, sliver);
+  EXPECT_GT(f, 0.05);
+  EXPECT_NEAR(f,
+              form_factor(r, -normal, std::vector<dvec3>{sliver[0], middle, sliver[2]}) +
+                  form_factor(r, -normal, std::vector<dvec3>{middle, sliver[1], sliver[2]}),
+              1e-12);
+}
+
+TEST(FormFactorExtremes, ReceiverWithinATwistedCornerSeesNothing) {
+  // Planar to 1e-9 of its size (4), but its corner at the origin, 6e-9
+  // across, drops 3e-9: a receiver 3e-10 above that corner is within the
+  // polygon's thickness, on it (F was -6.5e-4; libFuzzer kernels, crash-dd8d717d).
+  const std::vector<dvec3> p = {{-4.7165402388330148e-10, 2.9334841597860532e-310, 0.0},
+                                {0.0, -4.0, -3.2099434464697876e-09},
+                                {-3.2096664895593493e-09, 4.3486241962839191e-09, -2.1119385739660850e-09},
+                                {-4.0078836909046392e-09, -3.8029735139882818e-09, 1.1701537641651122e-09}};
+  EXPECT_EQ(form_factor(dvec3(0.0), kUp, p), 0.0);
+  EXPECT_EQ(form_factor_gradient(dvec3(0.0), kUp, p).value, 0.0);
+}
+
 TEST(FormFactorExtremes, CoordinatesOffsetBy1e6) {
   const dvec3 offset(1e6, -1e6, 1e6);
   auto quad = rectangle_facing_down(0, 1, 0, 1, 1);

@@ -91,6 +91,44 @@ class FormFactorValidation(unittest.TestCase):
         self.assert_value_error("polygon must be", [0, 0, 0], UP, None)
         self.assert_value_error("polygon must be", [0, 0, 0], UP, "square")
 
+    def test_coordinates_beyond_the_scene_range(self):
+        # Beyond kMaxCoordinate (1e30, core/scene.h) the kernels' products of
+        # lengths overflow (NaN visible-polygon anchors from 1e154 occluders).
+        self.assert_value_error("point has a coordinate of magnitude", [0, 0, 1e31], UP, SQUARE)
+        self.assert_value_error("polygon has a coordinate of magnitude", [0, 0, 0], UP, SQUARE * 1e31)
+        occluder = np.array([[[0, 0, 0.5], [1e200, 0, 0.5], [0, 1, 0.5]]])
+        for call in (rad.visible_form_factor, rad.visible_polygon):
+            with self.assertRaisesRegex(ValueError, "occluders has a coordinate of magnitude"):
+                call([0, 0, 0], UP, SQUARE, occluder)
+        # At the limit itself the answer is finite: the unit square seen from 1e29 away.
+        f, g = rad.visible_form_factor([0, 0, 0], UP, SQUARE * 1e29, occluder / 1e171)
+        self.assertTrue(np.isfinite(f) and np.all(np.isfinite(g)))
+
+
+class FormFactorNearTheEmitter(unittest.TestCase):
+    """Findings of the fuzzing campaign (issue 19): F of a planar convex emitter is in [0, 1]."""
+
+    SLIVER = np.array([[9.99938964836474, -9.842458791099524, -9.99999999941564],
+                       [2.8625488677062094, 2.862745098039216, 2.862745098039216],
+                       [2.862745098039216, 2.862745098039216, 2.862745098039216]])
+
+    def test_receiver_on_a_vertex_of_a_sliver_sees_nothing(self):
+        # The sliver's normal, from its long edges, is off by 1e-11: a receiver
+        # on vertex 2 was 2e-11 "in front" of v0's plane and got F = -0.033
+        # (atheris, 109 findings in 600 s).
+        n = np.array([-9.999999999999954, -7.490196078431373, -10.0])
+        for point in (self.SLIVER[2], [2.862745098039219, 2.8627450980392064, 2.862745098039214]):
+            self.assertEqual(rad.form_factor(point, n, self.SLIVER), 0.0)
+            self.assertEqual(rad.form_factor_gradient(point, n, self.SLIVER)[0], 0.0)
+
+    def test_tiny_polygon_matches_its_unit_scale_copy(self):
+        # Rescaled below 2^-200 (products of four lengths underflow below 1e-77;
+        # the C++ test goes to 1e-100, which read_polygon's area check refuses).
+        for scale in (1e-70, 1e-40, 1.0):
+            f, g = rad.form_factor_gradient([0, 0, 0], UP, SQUARE * scale)
+            self.assertAlmostEqual(f, 4 * corner_parallel(0.5, 0.5, 1.0), places=12)
+            self.assertTrue(np.all(np.isfinite(g * scale)))
+
 
 if __name__ == "__main__":
     unittest.main()
