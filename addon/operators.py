@@ -323,9 +323,11 @@ class RADIOSITY_OT_solve(Operator):
         coincident = export.coincident_message(job.exported, job.native_scene.coincident_faces)
         if coincident:
             warnings.append(coincident)
-        skipped_faces = len(job.native_scene.skipped_faces)
-        if skipped_faces:
-            warnings.append("%d degenerate face%s skipped" % (skipped_faces, "s" if skipped_faces > 1 else ""))
+        for notes, what in ((job.native_scene.skipped_faces, "faces left out:"),
+                            (job.native_scene.repaired_faces, "faces repaired:")):
+            message = export.face_notes_message(job.exported, notes, what)
+            if message:
+                warnings.append(message)
         if skipped_objects:
             warnings.append("no attribute on %s (instanced, shared or changed by modifiers)"
                             % ", ".join(sorted(set(skipped_objects))))

@@ -5,6 +5,7 @@
   (Blender 3.4, asked to give an ID a taken name, renames the other one);
 - NaN and Inf vertex coordinates: those faces are left out and named, the rest
   solves, and no NaN reaches the result;
+- broken faces (a bent quad, a bow-tie): repaired or left out, and named;
 - Image Texture nodes without pixels (no image, a missing or unreadable file):
   magenta, as Cycles renders them, named in the warning;
 - what Cycles does not render (disabled in renders, itself or by a collection,
@@ -14,6 +15,7 @@
 
 import math
 import os
+import re
 import tempfile
 import unittest
 
@@ -211,6 +213,33 @@ class NonFiniteCoordinatesTest(unittest.TestCase):
         light.location = (math.inf, 0.0, 1.0)
         warning = solve()
         self.assertIn("Far Light (a light)", warning)
+        for name, what, values in all_finite_results(scene):
+            self.assertTrue(np.isfinite(values).all(), (name, what))
+
+
+class BrokenFacesTest(unittest.TestCase):
+    def test_bent_quads_and_bow_ties_are_named(self):
+        # An imported model's everyday faults: a quad with a lifted corner
+        # (solved as Blender's two triangles) and a bow-tie (no inside: left out).
+        scene = open_scene("cube")
+        bent = quad(scene, "Bent", 0.5, size=0.4)
+        bent.data.vertices[2].co.z += 0.1
+        bow = quad(scene, "Bow", 0.6, size=0.4)
+        bow.data.vertices[1].co, bow.data.vertices[2].co = bow.data.vertices[2].co.copy(), bow.data.vertices[1].co.copy()
+        warning = solve()
+        found = re.search(r"faces repaired: Bent: 1 face not planar: split into 2 planar triangles \(([0-9.]+) %\)",
+                          warning)
+        self.assertIsNotNone(found, warning)
+        # The bend: the corners' largest distance from their best-fit plane over the diameter.
+        q = np.array([v.co for v in bent.data.vertices])
+        normal = np.cross(q[2] - q[0], q[3] - q[1])
+        normal /= np.linalg.norm(normal)
+        expected = 100 * np.max(np.abs((q - q.mean(axis=0)) @ normal)) / np.linalg.norm(q[2] - q[0])
+        self.assertAlmostEqual(float(found.group(1)), expected, delta=0.01)
+        self.assertIn("faces left out: Bow: 1 face its outline crosses itself", warning)
+        names = {o.name for o in bake.result_objects(scene)}
+        self.assertIn("Bent Radiosity", names)
+        self.assertNotIn("Bow Radiosity", names)
         for name, what, values in all_finite_results(scene):
             self.assertTrue(np.isfinite(values).all(), (name, what))
 
