@@ -54,7 +54,7 @@ class Job:
     progress: dict = field(default_factory=dict)
     result: object = None
     error: BaseException = None
-    started: float = field(default_factory=time.perf_counter)
+    started: float = field(default_factory=time.perf_counter)  # when the Solve began
 
 
 def native_options(options, total_area):
@@ -73,6 +73,25 @@ def native_options(options, total_area):
         "rays": int(options["rays"]),
         "bounces": int(options["bounces"]) or None,
     }
+
+
+# Writing a result into the scene (meshes, attributes, UV maps) takes about
+# this long per element on the 2-core reference machine (7.5 s for the 400,000
+# elements of a 200,000-face plane, bench/addon_budget.py).
+WRITE_SECONDS_PER_ELEMENT = 2e-5
+# What the solver gets when the export has used up the budget: its first pass.
+MIN_SOLVE_BUDGET = 0.05
+
+
+def solve_budget(budget, started, elements):
+    """The share of the user's time budget (seconds; 0: no limit) left to the
+    solver: the budget is for the whole Solve, so what the export took since
+    `started` is spent and writing the `elements` the solve starts with is
+    kept back."""
+    if not budget:
+        return None
+    left = budget - (time.perf_counter() - started) - WRITE_SECONDS_PER_ELEMENT * elements
+    return max(MIN_SOLVE_BUDGET, left)
 
 
 def visibility_hint(visibility, stats):
@@ -130,11 +149,12 @@ class RADIOSITY_OT_solve(Operator):
         return self._run(context)
 
     def invoke(self, context, event):
+        started = time.perf_counter()
         if bpy.app.background or context.window is None:
             return self._run(context)
         try:
             solver = native.load()
-            job = self._prepare(context, solver)
+            job = self._prepare(context, solver, started)
         except (native.NativeUnavailable, SolveError) as err:
             self.report({'ERROR'}, str(err))
             return {'CANCELLED'}
@@ -199,9 +219,10 @@ class RADIOSITY_OT_solve(Operator):
             job.error = err
 
     def _run(self, context):
+        started = time.perf_counter()
         try:
             solver = native.load()
-            return self._solve(context, solver)
+            return self._solve(context, solver, started)
         except (native.NativeUnavailable, SolveError) as err:
             self.report({'ERROR'}, str(err))
         except Exception as err:
@@ -216,9 +237,9 @@ class RADIOSITY_OT_solve(Operator):
                     % (type(err).__name__, err))
         return {'CANCELLED'}
 
-    def _solve(self, context, solver):
+    def _solve(self, context, solver, started):
         """Export the scene, solve with `solver` (the native module), bake the result."""
-        job = self._prepare(context, solver)
+        job = self._prepare(context, solver, started)
         progress = None
         if bpy.app.background:
             last = [None]
@@ -234,8 +255,10 @@ class RADIOSITY_OT_solve(Operator):
             raise SolveError("Radiosity: %s" % err) from None
         return self._conclude(context, job)
 
-    def _prepare(self, context, solver):
-        """Export the scene and make the native Scene (main thread)."""
+    def _prepare(self, context, solver, started=None):
+        """Export the scene and make the native Scene (main thread); the Solve
+        began at `started` (time.perf_counter; None: now)."""
+        started = time.perf_counter() if started is None else started
         scene = context.scene
         # What a render shows, the originals the last solve hid included, is read,
         # whatever the viewport hides; every flag is put back after.
@@ -260,9 +283,10 @@ class RADIOSITY_OT_solve(Operator):
             raise SolveError("Radiosity: %s" % err) from None
         settings = scene.radiosity
         label = settings.bl_rna.properties["oracle"].enum_items[settings.oracle].name
-        return Job(scene_name=scene.name, exported=exported, native_scene=native_scene,
-                   options=native_options(settings.solver_options(), native_scene.total_area),
-                   oracle_label=label)
+        options = native_options(settings.solver_options(), native_scene.total_area)
+        options["time_budget"] = solve_budget(settings.time_budget, started, 2 * native_scene.patch_count)
+        return Job(scene_name=scene.name, exported=exported, native_scene=native_scene, options=options,
+                   oracle_label=label, started=started)
 
     def _conclude(self, context, job):
         """Report a finished job's error, or bake its result (main thread)."""

@@ -143,8 +143,8 @@ class RadiositySettings(PropertyGroup):
     time_budget: FloatProperty(
         name="Time Budget",
         description=(
-            "Stop refining after this many seconds and keep the best solution "
-            "so far (0 for no limit)"
+            "Stop after about this many seconds, reading the scene and writing the result "
+            "included, and keep the best solution so far (0 for no limit)"
         ),
         min=0.0,
         default=0.0,
