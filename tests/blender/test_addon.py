@@ -344,7 +344,7 @@ class OperatorTest(unittest.TestCase):
         self.assertIn("native module could not be loaded: test", message)
 
     def test_unexpected_exception_becomes_a_report(self):
-        def broken(self, context, solver):
+        def broken(self, context, solver, started):
             raise ZeroDivisionError("simulated bug")
 
         saved = operators.RADIOSITY_OT_solve._solve
