@@ -19,6 +19,11 @@
 //    otherwise), whose integrand is analytic there; the order follows the gap.
 //    Each polygon keeps its own local origin, so an offset changes nothing
 //    beyond the rounding of the input itself.
+//  - Near pairs of very different sizes (radii more than 8 apart) have the
+//    larger polygon cut around the smaller: pieces beyond a square of
+//    half-width 4 radii about it are far pairs, the square's part a contour
+//    form of like sizes (the contour form alone loses digits in proportion to
+//    the ratio: F = 3.5e12 for a 1.5e-14 polygon on a 0.25 one, fuzzing).
 // Same conventions as form_factor.h: planar convex polygons, counter-clockwise
 // about their front normals; tolerances relative to the polygons' size.
 #pragma once

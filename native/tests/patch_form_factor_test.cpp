@@ -437,5 +437,26 @@ TEST(PatchFormFactor, NeighbourOneTrillionthTheSizeReturns) {
   EXPECT_LE(back, 1.0);
 }
 
+// A small square wall standing on the middle of a large floor, down to 1e-10
+// of its size: it sees the floor below its horizon, 1/2 less what lies
+// beyond the floor's edges (of order s / L). The contour form alone loses
+// digits in proportion to the sizes' ratio (fuzzing: F = 3.5e12 for a
+// 1.5e-14 polygon on a 0.25 one; here 21 s / L off at 1e-10, and reciprocity
+// broken from 1e-6).
+TEST(PatchFormFactor, SmallWallOnALargeFloorAtAnyRatio) {
+  const double half = 0.125;
+  const Polygon floor = floor_rectangle(-half, half, -half, half);
+  double worst = 0.0;
+  for (double s : {1e-2, 1e-4, 1e-6, 1e-8, 1e-10}) {
+    const Polygon wall = quad({0, -0.5 * s, 0}, {0, s, 0}, {0, 0, s});  // x = 0, facing +x
+    const double f = patch_form_factor(wall, floor);
+    worst = std::max(worst, std::abs(f - 0.5) / (s / half));
+    EXPECT_LE(f, 0.5 + 1e-9) << s;
+    EXPECT_NEAR(f, 0.5, 2.0 * s / half + 1e-9) << s;
+    EXPECT_NEAR(patch_form_factor(floor, wall) * area(floor), f * area(wall), 1e-9 * f * area(wall)) << s;
+  }
+  std::printf("small wall on a large floor: |F - 1/2| <= %.2f s / L\n", worst);
+}
+
 }  // namespace
 }  // namespace radiosity
