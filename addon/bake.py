@@ -28,6 +28,9 @@ from .export import HIDDEN_TAG, RESULT_TAG
 COLLECTION_NAME = "Radiosity"
 MATERIAL_NAME = "Radiosity Emission"
 ATTRIBUTE = "Radiosity"
+# On an original mesh whose "Radiosity" attribute the add-on wrote: one of the
+# user's own by that name is never overwritten or removed.
+ORIGINAL_ATTRIBUTE_TAG = "radiosity_attribute"
 MATERIAL_TAG = "radiosity_material"
 # Each side's polygons move this fraction of the scene's size towards the side
 # they show (4 um in a 2 m room), so the two sides of a face never coincide;
@@ -221,8 +224,9 @@ def write_original(scene, exported, result, convert=None):
     maps the (N, 3) radiance to the colours written, as in write_refined).
 
     Only for objects whose evaluated mesh has the original's topology (no
-    generating modifiers), that are not instances and do not share their mesh.
-    Returns the names of objects skipped.
+    generating modifiers), that are not instances, do not share their mesh and
+    have no "Radiosity" attribute of the user's own. Returns (object name,
+    reason) of those skipped.
     """
     arrays = exported.arrays
     extent = float(np.ptp(arrays["positions"], axis=0).max()) if len(arrays["positions"]) else 1.0
@@ -237,7 +241,10 @@ def write_original(scene, exported, result, convert=None):
         exported = np.arange(part.face_count) if part.polygons is None else part.polygons
         if (mesh is None or mesh.users > 1 or len(mesh.polygons) != (part.polygon_count or part.face_count)
                 or not np.array_equal(_loop_total(mesh)[exported], part.face_sizes)):
-            skipped.append(part.source)
+            skipped.append((part.source, "instanced, shared or changed by modifiers"))
+            continue
+        if mesh.color_attributes.get(ATTRIBUTE) is not None and not mesh.get(ORIGINAL_ATTRIBUTE_TAG):
+            skipped.append((part.source, "it has its own \"%s\" attribute" % ATTRIBUTE))
             continue
         targets.append((part, int(start), obj, mesh))
     if not targets:
@@ -267,6 +274,7 @@ def write_original(scene, exported, result, convert=None):
         per_loop = np.zeros((len(mesh.loops), 3), dtype=np.float32)
         per_loop[loops] = part_values
         set_colour_attribute(mesh, per_loop, 'CORNER')
+        mesh[ORIGINAL_ATTRIBUTE_TAG] = True
     return skipped
 
 
@@ -277,11 +285,13 @@ def _loop_total(mesh):
 
 
 def remove_original_attributes(scene):
+    """Remove the attributes write_original wrote (never a user's own)."""
     for obj in scene.objects:
-        if obj.type == 'MESH' and not obj.get(RESULT_TAG):
+        if obj.type == 'MESH' and not obj.get(RESULT_TAG) and obj.data.get(ORIGINAL_ATTRIBUTE_TAG):
             attr = obj.data.color_attributes.get(ATTRIBUTE)
             if attr is not None:
                 obj.data.color_attributes.remove(attr)
+            del obj.data[ORIGINAL_ATTRIBUTE_TAG]
 
 
 # --- Showing the result instead of the originals -----------------------------------------

@@ -352,9 +352,9 @@ class RADIOSITY_OT_solve(Operator):
             message = export.face_notes_message(job.exported, notes, what)
             if message:
                 warnings.append(message)
-        if skipped_objects:
-            warnings.append("no attribute on %s (instanced, shared or changed by modifiers)"
-                            % ", ".join(sorted(set(skipped_objects))))
+        for reason in sorted({why for _, why in skipped_objects}):
+            warnings.append("no attribute on %s (%s)" % (
+                ", ".join(sorted({name for name, why in skipped_objects if why == reason})), reason))
         s = settings.stats
         s.valid = True
         s.status = STATUS.get(stats.get("stopped_by", ""), str(stats.get("stopped_by", "")))

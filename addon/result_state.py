@@ -52,7 +52,8 @@ class SceneTransaction:
         for obj in scene.objects:
             if obj.type == 'MESH' and not obj.get(RESULT_TAG) and obj.data not in self.attributes:
                 attr = obj.data.color_attributes.get(bake.ATTRIBUTE)
-                self.attributes[obj.data] = None if attr is None else _copy_attribute(attr)
+                self.attributes[obj.data] = (None if attr is None else _copy_attribute(attr),
+                                             obj.data.get(bake.ORIGINAL_ATTRIBUTE_TAG))
         self.shading = [(space, space.shading.color_type) for space in _views()]
         return self
 
@@ -124,7 +125,11 @@ class SceneTransaction:
                 obj[HIDDEN_TAG] = tag
             if hidden is not None and layer.objects.get(obj.name) is not None:
                 obj.hide_set(hidden, view_layer=layer)
-        for mesh, saved in self.attributes.items():
+        for mesh, (saved, tag) in self.attributes.items():
+            if tag is None:
+                mesh.pop(bake.ORIGINAL_ATTRIBUTE_TAG, None)
+            else:
+                mesh[bake.ORIGINAL_ATTRIBUTE_TAG] = tag
             attrs = mesh.color_attributes
             current = attrs.get(bake.ATTRIBUTE)
             if current is not None:

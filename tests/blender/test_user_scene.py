@@ -3,6 +3,8 @@
 - user objects, meshes, materials and collections named as the add-on names its
   results: solve, re-solve, toggle and remove leave every one of them as it was
   (Blender 3.4, asked to give an ID a taken name, renames the other one);
+- a colour attribute of the user's own named as the add-on's: never
+  overwritten or removed, and named in the warning;
 - NaN and Inf vertex coordinates: those faces are left out and named, the rest
   solves, and no NaN reaches the result;
 - broken faces (a bent quad, a bow-tie): repaired or left out, and named;
@@ -173,6 +175,38 @@ class UserNamesTest(unittest.TestCase):
         check("remove")
         self.assertFalse(bake.result_objects(scene))
         self.assertFalse([o for o in bpy.data.objects if o.get(export.RESULT_TAG)])
+
+
+class UserAttributeTest(unittest.TestCase):
+    def test_a_users_own_radiosity_attribute_is_never_touched(self):
+        scene = open_scene("cube")
+        cube = scene.objects["Cube"]
+        mine = cube.data.color_attributes.new(bake.ATTRIBUTE, 'BYTE_COLOR', 'POINT')
+        values = np.linspace(0.0, 1.0, 4 * len(mine.data), dtype=np.float32)
+        mine.data.foreach_set("color", values)
+        stored = np.empty_like(values)
+        mine.data.foreach_get("color", stored)  # as bytes keep them
+
+        def unchanged():
+            attr = cube.data.color_attributes.get(bake.ATTRIBUTE)
+            self.assertIsNotNone(attr)
+            self.assertEqual((attr.data_type, attr.domain), ('BYTE_COLOR', 'POINT'))
+            now = np.empty_like(values)
+            attr.data.foreach_get("color", now)
+            np.testing.assert_array_equal(now, stored)
+
+        for output in ('ORIGINAL', 'BOTH'):
+            scene.radiosity.output = output
+            warning = solve()
+            self.assertIn('no attribute on Cube (it has its own "%s" attribute)' % bake.ATTRIBUTE, warning)
+            unchanged()
+            # The other originals get theirs.
+            others = [o for o in scene.objects if o.type == 'MESH' and o is not cube and not o.get(export.RESULT_TAG)]
+            self.assertTrue(any(o.data.color_attributes.get(bake.ATTRIBUTE) for o in others))
+        self.assertEqual(bpy.ops.radiosity.clear(), {'FINISHED'})
+        unchanged()
+        self.assertFalse(any(o.data.color_attributes.get(bake.ATTRIBUTE) for o in others),
+                         "Remove takes the attributes the add-on wrote")
 
 
 class NonFiniteCoordinatesTest(unittest.TestCase):
