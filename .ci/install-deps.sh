@@ -9,6 +9,7 @@ packages=(
   pybind11-dev libglm-dev libopenimageio-dev libembree-dev libtbb-dev
   libgtest-dev libbenchmark-dev
   xvfb libgl1-mesa-dri  # the interactive (modal, ESC) test runs Blender in a virtual display
+  clang-format-16       # tests/native/test_format.py: the C++ follows .clang-format
 )
 
 # `make fuzz` (tools/fuzz.py) builds its libFuzzer harnesses and an instrumented

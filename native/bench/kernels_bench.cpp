@@ -40,7 +40,8 @@ std::vector<ContourVertex> visible_dodecagon() {
       contour.push_back(ContourVertex::intrinsic(p, dvec3(p.x * 0.6, p.y * 0.6, 0.6)));
     } else {
       const Line emitter_line{p, {-std::sin(angle), std::cos(angle), 0}};
-      const Line occluder_line{{p.x * 0.6, p.y * 0.6, 0.6}, {std::cos(angle), std::sin(angle), 0.3}};
+      const Line occluder_line{{p.x * 0.6, p.y * 0.6, 0.6},
+                               {std::cos(angle), std::sin(angle), 0.3}};
       contour.push_back(ContourVertex::apparent_vertex(p, emitter_line, occluder_line));
     }
   }

@@ -115,7 +115,8 @@ BENCHMARK(BM_ShadowRays_EmbreeOccluded8)->Unit(benchmark::kMicrosecond);
 // against the whole scene does not): where the two cross over.
 void BM_ShadowRays_OwnAgainstNCandidates(benchmark::State& state) {
   const ClutterScene& s = clutter();
-  const auto count = std::min<std::size_t>(static_cast<std::size_t>(state.range(0)), s.candidates.size());
+  const auto count =
+      std::min<std::size_t>(static_cast<std::size_t>(state.range(0)), s.candidates.size());
   const std::span<const Triangle> candidates(s.candidates.data(), count);
   EmitterSamples samples;
   samples.weights.assign(64, 1.0);
@@ -130,7 +131,12 @@ void BM_ShadowRays_OwnAgainstNCandidates(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * 4096);
   state.counters["candidates"] = static_cast<double>(count);
 }
-BENCHMARK(BM_ShadowRays_OwnAgainstNCandidates)->Arg(1)->Arg(4)->Arg(16)->Arg(64)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ShadowRays_OwnAgainstNCandidates)
+    ->Arg(1)
+    ->Arg(4)
+    ->Arg(16)
+    ->Arg(64)
+    ->Unit(benchmark::kMicrosecond);
 
 void BM_ShaftCulling_Bvh(benchmark::State& state) {
   const ClutterScene& s = clutter();
@@ -164,14 +170,16 @@ std::vector<Triangle> random_triangles(std::size_t count) {
 }
 
 void BM_BuildBvh_Own(benchmark::State& state) {
-  const std::vector<Triangle> triangles = random_triangles(static_cast<std::size_t>(state.range(0)));
+  const std::vector<Triangle> triangles =
+      random_triangles(static_cast<std::size_t>(state.range(0)));
   for (auto _ : state) benchmark::DoNotOptimize(build_scene_bvh(triangles).nodes.data());
   state.SetItemsProcessed(state.iterations() * state.range(0));
 }
 BENCHMARK(BM_BuildBvh_Own)->Arg(5000)->Arg(200000)->Unit(benchmark::kMillisecond);
 
 void BM_BuildBvh_Embree(benchmark::State& state) {
-  const std::vector<Triangle> triangles = random_triangles(static_cast<std::size_t>(state.range(0)));
+  const std::vector<Triangle> triangles =
+      random_triangles(static_cast<std::size_t>(state.range(0)));
   for (auto _ : state) benchmark::DoNotOptimize(build_scene_bvh_embree(triangles).nodes.data());
   state.SetItemsProcessed(state.iterations() * state.range(0));
 }
@@ -201,7 +209,8 @@ void BM_ShaftCulling_Tree(benchmark::State& state) {
     candidates += c.candidates.size();
     i = (i + 1) % links.size();
   }
-  state.counters["candidates"] = static_cast<double>(candidates) / static_cast<double>(state.iterations());
+  state.counters["candidates"] =
+      static_cast<double>(candidates) / static_cast<double>(state.iterations());
   state.counters["nodes"] = static_cast<double>(scene.bvh.nodes.size());
 }
 BENCHMARK(BM_ShaftCulling_Tree)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
@@ -239,9 +248,11 @@ void BM_ExactVisiblePolygon(benchmark::State& state) {
   std::size_t i = 0;
   double pieces = 0.0;
   for (std::size_t k = 0; k < c.points.size(); ++k)
-    pieces += static_cast<double>(visible_polygon(c.points[k], n, c.emitter, c.occluders[k]).pieces.size());
+    pieces += static_cast<double>(
+        visible_polygon(c.points[k], n, c.emitter, c.occluders[k]).pieces.size());
   for (auto _ : state) {
-    const FormFactorGradient fg = visible_form_factor_gradient(c.points[i], n, c.emitter, c.occluders[i]);
+    const FormFactorGradient fg =
+        visible_form_factor_gradient(c.points[i], n, c.emitter, c.occluders[i]);
     benchmark::DoNotOptimize(fg.value);
     i = (i + 1) % c.points.size();
   }
@@ -272,7 +283,8 @@ void BM_ExactVisibleBoxes(benchmark::State& state) {
       const auto corner = [&](int i) {
         return dvec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
       };
-      const int faces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+      const int faces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
+                               {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
       for (const auto& f : faces) {
         tris.push_back(Triangle{{corner(f[0]), corner(f[1]), corner(f[2])}});
         tris.push_back(Triangle{{corner(f[0]), corner(f[2]), corner(f[3])}});
@@ -289,7 +301,8 @@ void BM_ExactVisibleBoxes(benchmark::State& state) {
   const dvec3 n(0.0, 0.0, 1.0);
   double pieces = 0.0;
   for (std::size_t k = 0; k < points.size(); ++k)
-    pieces += static_cast<double>(visible_polygon(points[k], n, emitter, occluders[k]).pieces.size());
+    pieces +=
+        static_cast<double>(visible_polygon(points[k], n, emitter, occluders[k]).pieces.size());
   std::size_t i = 0;
   for (auto _ : state) {
     const FormFactorGradient fg = visible_form_factor_gradient(points[i], n, emitter, occluders[i]);
@@ -314,10 +327,12 @@ void BM_SampledVisibility(benchmark::State& state) {
   options.rays = rays;
   for (std::size_t k = 0; k < c.points.size(); ++k) {
     scenes.push_back(std::make_unique<RayScene>(c.occluders[k]));
-    const double exact = visible_form_factor_gradient(c.points[k], n, c.emitter, c.occluders[k]).value;
+    const double exact =
+        visible_form_factor_gradient(c.points[k], n, c.emitter, c.occluders[k]).value;
     const double unoccluded = form_factor(c.points[k], n, c.emitter);
     options.seed = k;
-    const double sampled = sampled_form_factor_gradient(c.points[k], n, c.emitter, *scenes[k], options).value;
+    const double sampled =
+        sampled_form_factor_gradient(c.points[k], n, c.emitter, *scenes[k], options).value;
     error += std::abs(sampled - exact) / unoccluded / static_cast<double>(c.points.size());
   }
   std::size_t i = 0;
@@ -339,7 +354,8 @@ void BM_ExactVisibility4(benchmark::State& state) {
   const dvec3 n(0.0, 0.0, 1.0);
   std::size_t i = 0;
   for (auto _ : state) {
-    const FormFactorGradient fg = visible_form_factor_gradient(c.points[i], n, c.emitter, c.occluders[i]);
+    const FormFactorGradient fg =
+        visible_form_factor_gradient(c.points[i], n, c.emitter, c.occluders[i]);
     benchmark::DoNotOptimize(fg.value);
     i = (i + 1) % c.points.size();
   }

@@ -46,8 +46,10 @@ bool flat_pair_apart(const ClusterNode& rx, const ClusterNode& ry) {
 dvec3 random_point(const ClusterTree& tree, const Hierarchy& hierarchy, const ClusterNode& node,
                    SplitMix64& random, std::uint32_t& face) {
   const auto& prefix = tree.area_prefix();
-  const double target = prefix[node.first] + random.uniform() * (prefix[node.first + node.count] - prefix[node.first]);
-  const auto it = std::upper_bound(prefix.begin() + node.first + 1, prefix.begin() + node.first + node.count, target);
+  const double target = prefix[node.first] +
+                        random.uniform() * (prefix[node.first + node.count] - prefix[node.first]);
+  const auto it = std::upper_bound(prefix.begin() + node.first + 1,
+                                   prefix.begin() + node.first + node.count, target);
   const auto index = static_cast<size_t>(it - prefix.begin()) - 1;
   const Element& e = hierarchy.element(tree.sides()[index]);
   face = hierarchy.patch_of(e).surface;
@@ -65,7 +67,14 @@ dvec3 random_point(const ClusterTree& tree, const Hierarchy& hierarchy, const Cl
 
 // What the walk does with one pair of clusters.
 struct PairOutcome {
-  enum Kind : std::uint8_t { Drop, ClusterPair, ElementPair, SplitReceiver, SplitEmitter, SplitBoth } kind = Drop;
+  enum Kind : std::uint8_t {
+    Drop,
+    ClusterPair,
+    ElementPair,
+    SplitReceiver,
+    SplitEmitter,
+    SplitBoth
+  } kind = Drop;
   ClusterLink link;  // ClusterPair: the link; ElementPair: its receiver and emitter elements
 };
 
@@ -74,7 +83,7 @@ struct PairOutcome {
 int passing_rays(const ClusterTree& tree, const Hierarchy& hierarchy, const RayScene& scene,
                  std::int32_t receiver, std::int32_t emitter, int rays) {
   SplitMix64 random{(static_cast<std::uint64_t>(static_cast<std::uint32_t>(receiver)) << 32) |
-                static_cast<std::uint32_t>(emitter)};
+                    static_cast<std::uint32_t>(emitter)};
   int passed = 0;
   for (int k = 0; k < rays; ++k) {
     std::uint32_t from_face = 0, to_face = 0;
@@ -103,15 +112,16 @@ PairOutcome classify(const ClusterTree& tree, const Hierarchy& hierarchy, const 
   if (d > 0.0) {
     const dvec3 w = between / d;
     // Directions between any two points of the two bounds.
-    const double cone = d > rx.radius + ry.radius ? std::asin((rx.radius + ry.radius) / d) : 0.5 * std::numbers::pi;
+    const double cone =
+        d > rx.radius + ry.radius ? std::asin((rx.radius + ry.radius) / d) : 0.5 * std::numbers::pi;
     if (none_facing(ry, w, cone) || none_facing(rx, -w, cone)) return out;
     // Facing is judged along the centres' direction only: where the clusters
     // are far apart, a side seen at a grazing angle from part of the other
     // carries little light either way.
     // Light straight from emitters, the brightest in any scene, always goes
     // through face links (exact visibility at the receiver's samples).
-    if (!both_leaves && !ry.emits && d > separation * (rx.radius + ry.radius) && all_facing(ry, w, 0.0) &&
-        all_facing(rx, -w, 0.0)) {
+    if (!both_leaves && !ry.emits && d > separation * (rx.radius + ry.radius) &&
+        all_facing(ry, w, 0.0) && all_facing(rx, -w, 0.0)) {
       // A cluster link ends on one side: the distance to the emitter cluster
       // is then that side's own (a receiving cluster would give the light of
       // its centre to every side, off by 2 r / d).
@@ -121,8 +131,10 @@ PairOutcome classify(const ClusterTree& tree, const Hierarchy& hierarchy, const 
       out.kind = PairOutcome::ClusterPair;
       out.link.receiver = x;
       out.link.emitter = y;
-      out.link.direction = {static_cast<float>(w.x), static_cast<float>(w.y), static_cast<float>(w.z)};
-      out.link.coupling = static_cast<float>(passed) / static_cast<float>(rays) / static_cast<float>(std::numbers::pi * d * d);
+      out.link.direction = {static_cast<float>(w.x), static_cast<float>(w.y),
+                            static_cast<float>(w.z)};
+      out.link.coupling = static_cast<float>(passed) / static_cast<float>(rays) /
+                          static_cast<float>(std::numbers::pi * d * d);
       return out;
     }
   }
@@ -130,15 +142,17 @@ PairOutcome classify(const ClusterTree& tree, const Hierarchy& hierarchy, const 
     const std::int32_t p = tree.sides()[rx.first], q = tree.sides()[ry.first];
     const Element& receiver = hierarchy.element(p);
     const Element& emitter = hierarchy.element(q);
-    if (receiver.patch == emitter.patch || !elements_face_each_other(hierarchy, receiver, emitter)) return out;
+    if (receiver.patch == emitter.patch || !elements_face_each_other(hierarchy, receiver, emitter))
+      return out;
     out.kind = PairOutcome::ElementPair;
     out.link.receiver = p;
     out.link.emitter = q;
     return out;
   }
   // Split the larger cluster.
-  return split(!rx.is_leaf() && (ry.is_leaf() || rx.radius >= ry.radius) ? PairOutcome::SplitReceiver
-                                                                          : PairOutcome::SplitEmitter);
+  return split(!rx.is_leaf() && (ry.is_leaf() || rx.radius >= ry.radius)
+                   ? PairOutcome::SplitReceiver
+                   : PairOutcome::SplitEmitter);
 }
 
 }  // namespace
@@ -171,15 +185,17 @@ int children(const ClusterTree& tree, const PairOutcome& o, std::int32_t x, std:
       for (std::int32_t a : tree.node(x).child)
         for (std::int32_t b : tree.node(x).child) out[n++] = {a, b};
       break;
-    default: break;
+    default:
+      break;
   }
   return n;
 }
 
 }  // namespace
 
-InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy, const RayScene& scene,
-                           double separation, int rays, const std::function<bool()>& cancelled,
+InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy,
+                           const RayScene& scene, double separation, int rays,
+                           const std::function<bool()>& cancelled,
                            const std::function<void(double)>& progress) {
   InitialLinks links;
   if (tree.root() == kNone) return links;
@@ -262,8 +278,9 @@ void ClusterGather::operator()(const ClusterTree& tree, const std::vector<Cluste
       p = {l.x * n, l.y * n, l.z * n};
     } else {
       for (int c = 0; c < 3; ++c)
-        p[static_cast<size_t>(c)] = power_[static_cast<size_t>(node.child[0])][static_cast<size_t>(c)] +
-                                    power_[static_cast<size_t>(node.child[1])][static_cast<size_t>(c)];
+        p[static_cast<size_t>(c)] =
+            power_[static_cast<size_t>(node.child[0])][static_cast<size_t>(c)] +
+            power_[static_cast<size_t>(node.child[1])][static_cast<size_t>(c)];
     }
   }
   // Each link: the emitter's intensity towards the receiving side, taken
@@ -276,7 +293,8 @@ void ClusterGather::operator()(const ClusterTree& tree, const std::vector<Cluste
     const double cosine = std::max(0.0, -glm::dot(hierarchy.normal(hierarchy.element(side)), w));
     Rgb& g = gathered[static_cast<size_t>(side)];
     for (int c = 0; c < 3; ++c)
-      g[c] += static_cast<double>(link.coupling) * cosine * std::max(0.0, glm::dot(p[static_cast<size_t>(c)], w));
+      g[c] += static_cast<double>(link.coupling) * cosine *
+              std::max(0.0, glm::dot(p[static_cast<size_t>(c)], w));
   }
 }
 

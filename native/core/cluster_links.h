@@ -32,7 +32,7 @@
 namespace radiosity {
 
 struct ClusterLink {
-  std::int32_t receiver = kNone;   // cluster nodes
+  std::int32_t receiver = kNone;  // cluster nodes
   std::int32_t emitter = kNone;
   std::array<float, 3> direction{};  // unit, emitter centroid to receiver centroid
   float coupling = 0.0f;             // visible fraction / (pi d^2)
@@ -47,8 +47,9 @@ struct InitialLinks {
 // link. Returns early (incomplete) once `cancelled` (called from worker
 // threads, so it must be thread-safe) says so; `progress`, if
 // set, hears the fraction of the walk done (from the walking thread).
-InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy, const RayScene& scene,
-                           double separation, int rays, const std::function<bool()>& cancelled,
+InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy,
+                           const RayScene& scene, double separation, int rays,
+                           const std::function<bool()>& cancelled,
                            const std::function<void(double)>& progress = {});
 
 // What every top-level element gathers through the cluster links, uniform
@@ -56,13 +57,14 @@ InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy, 
 // The emitters' power vectors are summed up the tree once per call.
 class ClusterGather {
  public:
-  void operator()(const ClusterTree& tree, const std::vector<ClusterLink>& links, const Hierarchy& hierarchy,
-                  const std::vector<Rgb>& radiance, std::vector<Rgb>& gathered);
+  void operator()(const ClusterTree& tree, const std::vector<ClusterLink>& links,
+                  const Hierarchy& hierarchy, const std::vector<Rgb>& radiance,
+                  std::vector<Rgb>& gathered);
   std::size_t memory_bytes() const { return power_.capacity() * sizeof(ChannelVectors); }
 
  private:
   using ChannelVectors = std::array<dvec3, 3>;  // one vector per colour channel
-  std::vector<ChannelVectors> power_;  // per cluster node
+  std::vector<ChannelVectors> power_;           // per cluster node
 };
 
 }  // namespace radiosity

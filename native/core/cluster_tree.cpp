@@ -23,7 +23,8 @@ ClusterTree::ClusterTree(const Hierarchy& hierarchy) {
       const std::int32_t root = hierarchy.root(p, side);
       if (root == kNone) continue;
       const Element& e = hierarchy.element(root);
-      if (luminance(hierarchy.reflectance(e)) > 0.0 || luminance(hierarchy.emission(e)) > 0.0) sides_.push_back(root);
+      if (luminance(hierarchy.reflectance(e)) > 0.0 || luminance(hierarchy.emission(e)) > 0.0)
+        sides_.push_back(root);
     }
   }
   if (sides_.empty()) return;
@@ -34,7 +35,8 @@ ClusterTree::ClusterTree(const Hierarchy& hierarchy) {
     area_prefix_[i + 1] = area_prefix_[i] + hierarchy.element(sides_[i]).area;
 }
 
-std::int32_t ClusterTree::build(const Hierarchy& hierarchy, std::uint32_t first, std::uint32_t count) {
+std::int32_t ClusterTree::build(const Hierarchy& hierarchy, std::uint32_t first,
+                                std::uint32_t count) {
   const auto index = static_cast<std::int32_t>(nodes_.size());
   nodes_.emplace_back();
   const auto begin = sides_.begin() + first, end = begin + count;
@@ -56,19 +58,22 @@ std::int32_t ClusterTree::build(const Hierarchy& hierarchy, std::uint32_t first,
     node.centre += e.area * hierarchy.centre(e);
     node.area += e.area;
     node.reflects |= luminance(hierarchy.reflectance(e)) > 0.0;
-    node.sends |= luminance(hierarchy.reflectance(e)) > 0.0 || luminance(hierarchy.emission(e)) > 0.0;
+    node.sends |=
+        luminance(hierarchy.reflectance(e)) > 0.0 || luminance(hierarchy.emission(e)) > 0.0;
     node.emits |= luminance(hierarchy.emission(e)) > 0.0;
   }
   node.centre = node.area > 0.0 ? node.centre / node.area : 0.5 * (lo + hi);
   for (auto it = begin; it != end; ++it) {
     dvec3 corners[4];
     const int n = hierarchy.corners(hierarchy.element(*it), corners);
-    for (int k = 0; k < n; ++k) node.radius = std::max(node.radius, glm::length(corners[k] - node.centre));
+    for (int k = 0; k < n; ++k)
+      node.radius = std::max(node.radius, glm::length(corners[k] - node.centre));
   }
   const double length = glm::length(weighted_normal);
   node.axis = length > 0.0 ? weighted_normal / length : hierarchy.normal(hierarchy.element(*begin));
   for (auto it = begin; it != end; ++it) {
-    const double c = std::clamp(glm::dot(node.axis, hierarchy.normal(hierarchy.element(*it))), -1.0, 1.0);
+    const double c =
+        std::clamp(glm::dot(node.axis, hierarchy.normal(hierarchy.element(*it))), -1.0, 1.0);
     node.spread = std::max(node.spread, std::acos(c));
   }
   node.height_lo = std::numeric_limits<double>::infinity();
@@ -85,24 +90,32 @@ std::int32_t ClusterTree::build(const Hierarchy& hierarchy, std::uint32_t first,
   if (count > 1) {
     // Facing classes first (sides in one class face within 55 degrees of an
     // axis), then halves along the longest extent of the centres.
-    const auto class_of = [&](std::int32_t e) { return facing_class(hierarchy.normal(hierarchy.element(e))); };
+    const auto class_of = [&](std::int32_t e) {
+      return facing_class(hierarchy.normal(hierarchy.element(e)));
+    };
     const auto centre_of = [&](std::int32_t e) { return hierarchy.centre(hierarchy.element(e)); };
-    std::stable_sort(begin, end, [&](std::int32_t a, std::int32_t b) { return class_of(a) < class_of(b); });
+    std::stable_sort(begin, end,
+                     [&](std::int32_t a, std::int32_t b) { return class_of(a) < class_of(b); });
     std::uint32_t half = 0;
     if (class_of(*begin) != class_of(*(end - 1))) {
       // The class boundary nearest the middle.
       std::uint32_t best = count;
       for (std::uint32_t i = 1; i < count; ++i) {
         if (class_of(*(begin + i)) == class_of(*(begin + i - 1))) continue;
-        const auto distance = [&](std::uint32_t k) { return k > count / 2 ? k - count / 2 : count / 2 - k; };
+        const auto distance = [&](std::uint32_t k) {
+          return k > count / 2 ? k - count / 2 : count / 2 - k;
+        };
         if (best == count || distance(i) < distance(best)) best = i;
       }
       half = best;
     } else {
       dvec3 low(std::numeric_limits<double>::infinity()), high = -low;
-      for (auto it = begin; it != end; ++it) low = glm::min(low, centre_of(*it)), high = glm::max(high, centre_of(*it));
+      for (auto it = begin; it != end; ++it)
+        low = glm::min(low, centre_of(*it)), high = glm::max(high, centre_of(*it));
       const dvec3 extent = high - low;
-      const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
+      const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0
+                       : extent.y >= extent.z                       ? 1
+                                                                    : 2;
       half = count / 2;
       // Ties broken by element id: the tree does not depend on the sort's luck.
       std::nth_element(begin, begin + half, end, [&](std::int32_t a, std::int32_t b) {

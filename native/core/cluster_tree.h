@@ -14,10 +14,10 @@
 namespace radiosity {
 
 struct ClusterNode {
-  dvec3 centre{0.0};        // area-weighted centroid of its sides
-  double radius = 0.0;      // of the sphere about `centre` holding every side
-  dvec3 axis{0.0};          // of the normals' cone (area-weighted mean normal)
-  double spread = 0.0;      // the cone's half-angle, radians
+  dvec3 centre{0.0};    // area-weighted centroid of its sides
+  double radius = 0.0;  // of the sphere about `centre` holding every side
+  dvec3 axis{0.0};      // of the normals' cone (area-weighted mean normal)
+  double spread = 0.0;  // the cone's half-angle, radians
   // Heights of its sides' corners along `axis`: where every side faces along
   // the axis (is_flat: a floor, a tiled wall), a side sees only what rises
   // above its own plane (cluster_links.cpp prunes coplanar pairs with this).
@@ -27,9 +27,9 @@ struct ClusterNode {
   double area = 0.0;
   std::int32_t child[2] = {kNone, kNone};
   std::uint32_t first = 0, count = 0;  // its sides: ClusterTree::sides()[first, first + count)
-  bool reflects = false;    // some side reflects (can receive)
-  bool sends = false;       // some side emits or reflects
-  bool emits = false;       // some side emits
+  bool reflects = false;               // some side reflects (can receive)
+  bool sends = false;                  // some side emits or reflects
+  bool emits = false;                  // some side emits
   bool is_leaf() const { return child[0] == kNone; }
 };
 

@@ -11,8 +11,6 @@ using Rgb = glm::dvec3;
 
 // Brightness of a linear RGB value (Rec. 709 luminance, Blender's default
 // scene-linear primaries): how the oracles reduce colour to one number.
-inline double luminance(const Rgb& c) {
-  return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
-}
+inline double luminance(const Rgb& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
 
 }  // namespace radiosity

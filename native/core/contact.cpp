@@ -4,8 +4,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <cmath>
+#include <cstdlib>
 #include <vector>
 
 #include "core/scene_bvh.h"
@@ -15,11 +15,11 @@ namespace radiosity {
 namespace {
 
 constexpr double kParallelCosine = 0.99619469809174553;  // cos 5 degrees
-constexpr double kCoverGap = 0.1;           // of the smaller face's diameter
-constexpr double kFootGap = 0.01;           // of the touching face's diameter
-constexpr double kCoincident = 1e-5;        // of the larger face's diameter
-constexpr double kCoincidentScene = 1e-6;   // of the scene's diameter
-constexpr double kThinnest = 1e-4;          // of the cut face's diameter
+constexpr double kCoverGap = 0.1;                        // of the smaller face's diameter
+constexpr double kFootGap = 0.01;                        // of the touching face's diameter
+constexpr double kCoincident = 1e-5;                     // of the larger face's diameter
+constexpr double kCoincidentScene = 1e-6;                // of the scene's diameter
+constexpr double kThinnest = 1e-4;                       // of the cut face's diameter
 // Pieces narrower than this share of the cut face's diameter are not cut off
 // unless a light makes the cut: the strip under a cabinet's 3 cm side panel
 // or the 1 cm between a cabinet and the wall behind it, cut across a 5 m
@@ -67,13 +67,16 @@ Frame frame_of(const Patch& p) {
 double diameter_of(const Patch& p) {
   double d = 0.0;
   for (int i = 0; i < p.corner_count; ++i)
-    for (int j = i + 1; j < p.corner_count; ++j) d = std::max(d, glm::length(p.corners[static_cast<size_t>(i)] - p.corners[static_cast<size_t>(j)]));
+    for (int j = i + 1; j < p.corner_count; ++j)
+      d = std::max(
+          d, glm::length(p.corners[static_cast<size_t>(i)] - p.corners[static_cast<size_t>(j)]));
   return d;
 }
 
 double signed_area(const std::vector<dvec2>& polygon) {
   double a = 0.0;
-  for (size_t i = 0; i < polygon.size(); ++i) a += cross2(polygon[i], polygon[(i + 1) % polygon.size()]);
+  for (size_t i = 0; i < polygon.size(); ++i)
+    a += cross2(polygon[i], polygon[(i + 1) % polygon.size()]);
   return 0.5 * a;
 }
 
@@ -121,8 +124,10 @@ double length_inside(const Polygon2& piece, const Segment& s, double t0 = 0.0, d
       continue;
     }
     const double t = -num / den;
-    if (den > 0.0) t0 = std::max(t0, t);
-    else t1 = std::min(t1, t);
+    if (den > 0.0)
+      t0 = std::max(t0, t);
+    else
+      t1 = std::min(t1, t);
     if (t0 >= t1) return 0.0;
   }
   return (t1 - t0) * glm::length(d);
@@ -130,7 +135,8 @@ double length_inside(const Polygon2& piece, const Segment& s, double t0 = 0.0, d
 
 // Splits a convex piece along the line of `s`. False (no split) when either
 // side would be thinner than `thinnest` across the line.
-bool split(const Polygon2& piece, const Segment& s, double thinnest, Polygon2& left, Polygon2& right) {
+bool split(const Polygon2& piece, const Segment& s, double thinnest, Polygon2& left,
+           Polygon2& right) {
   const dvec2 d = glm::normalize(s.b - s.a);
   const double on_line = 1e-3 * thinnest;
   std::vector<double> distance(piece.size());
@@ -150,7 +156,8 @@ bool split(const Polygon2& piece, const Segment& s, double thinnest, Polygon2& l
     if (di <= on_line) right.push_back(piece[i]);
     if ((di > on_line && dj < -on_line) || (di < -on_line && dj > on_line)) {
       const double t = di / (di - dj);
-      const Vertex v{piece[i].p + t * (piece[j].p - piece[i].p), piece[i].x + t * (piece[j].x - piece[i].x)};
+      const Vertex v{piece[i].p + t * (piece[j].p - piece[i].p),
+                     piece[i].x + t * (piece[j].x - piece[i].x)};
       left.push_back(v);
       right.push_back(v);
     }
@@ -179,7 +186,8 @@ std::vector<Polygon2> cut_along(const Polygon2& whole, std::vector<Cut> cuts, do
       double past_ends = 0.0;
       for (const Polygon2& piece : pieces) {
         const double inside = length_inside(piece, cuts[k].segment);
-        if (inside > thinnest) past_ends += length_inside(piece, cuts[k].segment, -1e9, 1e9) - inside;
+        if (inside > thinnest)
+          past_ends += length_inside(piece, cuts[k].segment, -1e9, 1e9) - inside;
       }
       if (past_ends < least) least = past_ends, best = k;
     }
@@ -187,7 +195,8 @@ std::vector<Polygon2> cut_along(const Polygon2& whole, std::vector<Cut> cuts, do
     cuts.erase(cuts.begin() + static_cast<std::ptrdiff_t>(best));
     std::vector<Polygon2> next;
     for (const Polygon2& piece : pieces) {
-      if (length_inside(piece, cut.segment) > thinnest && split(piece, cut.segment, cut.narrowest, left, right)) {
+      if (length_inside(piece, cut.segment) > thinnest &&
+          split(piece, cut.segment, cut.narrowest, left, right)) {
         next.push_back(left);
         next.push_back(right);
       } else {
@@ -230,9 +239,11 @@ Contact contact_of(const Frame& f, double dp, const Patch& q, double dq, double 
     if (farthest > kCoverGap * std::min(dp, dq)) return out;
     if (dq < kSmallest * dp && !emits(q)) return out;
     std::vector<dvec2> outline;
-    for (int i = 0; i < q.corner_count; ++i) outline.push_back(f.to2(q.corners[static_cast<size_t>(i)]));
+    for (int i = 0; i < q.corner_count; ++i)
+      outline.push_back(f.to2(q.corners[static_cast<size_t>(i)]));
     if (signed_area(outline) < 0.0) std::reverse(outline.begin(), outline.end());
-    for (size_t i = 0; i < outline.size(); ++i) out.cuts.push_back({outline[i], outline[(i + 1) % outline.size()]});
+    for (size_t i = 0; i < outline.size(); ++i)
+      out.cuts.push_back({outline[i], outline[(i + 1) % outline.size()]});
     out.coincident = farthest <= touch;
     out.gap = farthest;
     out.cover_outline = std::move(outline);
@@ -247,7 +258,8 @@ Contact contact_of(const Frame& f, double dp, const Patch& q, double dq, double 
       const int j = (i + 1) % q.corner_count;
       const dvec3& a = q.corners[static_cast<size_t>(i)];
       const dvec3& b = q.corners[static_cast<size_t>(j)];
-      if (std::abs(s[i]) <= touch) points.push_back(a);
+      if (std::abs(s[i]) <= touch)
+        points.push_back(a);
       else if ((s[i] > touch && s[j] < -touch) || (s[i] < -touch && s[j] > touch))
         points.push_back(a + (s[i] / (s[i] - s[j])) * (b - a));
     }
@@ -306,8 +318,8 @@ double distance_to_segment(const dvec2& p, const Segment& s) {
 
 // Classes of the piece's corners and insets of its edges (Patch); `thinnest`
 // is kThinnest of the patch's diameter.
-void mark_discontinuities(Piece& piece, const Polygon2& polygon, const Polygon2& whole, const Features& features,
-                          const dvec2& centroid, double thinnest) {
+void mark_discontinuities(Piece& piece, const Polygon2& polygon, const Polygon2& whole,
+                          const Features& features, const dvec2& centroid, double thinnest) {
   const double near = 1e-3 * thinnest;
   const size_t n = polygon.size();
   piece.corner_class.assign(n, 0u);
@@ -335,7 +347,8 @@ void mark_discontinuities(Piece& piece, const Polygon2& polygon, const Polygon2&
       const dvec2 d = s.b - s.a;
       const double t = glm::dot(inner - s.a, d) / glm::dot(d, d);
       const int side = t < 0.0 || t > 1.0 ? 2 : (cross2(d, inner - s.a) > 0.0 ? 1 : 0);
-      signature = signature * 1000003u + 3 * (k + features.covers.size()) + static_cast<std::uint64_t>(side);
+      signature = signature * 1000003u + 3 * (k + features.covers.size()) +
+                  static_cast<std::uint64_t>(side);
     }
     if (on_line) piece.corner_class[i] = static_cast<std::uint32_t>(signature | 1u << 31);
     // Edges along the outline of a cover some gap away, and along a line
@@ -350,7 +363,8 @@ void mark_discontinuities(Piece& piece, const Polygon2& polygon, const Polygon2&
       own_edge = distance_to_segment(v, edge) <= near && distance_to_segment(w, edge) <= near;
     }
     for (const Features::Meeting& m : features.meetings) {
-      if (m.crosses && !own_edge && distance_to_segment(v, m.segment) <= near && distance_to_segment(w, m.segment) <= near)
+      if (m.crosses && !own_edge && distance_to_segment(v, m.segment) <= near &&
+          distance_to_segment(w, m.segment) <= near)
         piece.edge_inset[i] = std::max(piece.edge_inset[i], static_cast<float>(10.0 * thinnest));
     }
     for (const Features::Cover& cover : features.covers) {
@@ -377,7 +391,8 @@ void append_patches(const Patch& source, const Piece& piece, std::vector<Patch>&
     const dvec2& here = poly[i].p;
     const dvec2& next = poly[(i + 1) % poly.size()].p;
     const bool dropped = glm::length(here - prev) <= 1e-9 * scale ||
-                         cross2(here - prev, next - here) <= 1e-9 * glm::length(here - prev) * glm::length(next - here);
+                         cross2(here - prev, next - here) <=
+                             1e-9 * glm::length(here - prev) * glm::length(next - here);
     if (dropped) {
       // The edge before it now runs on: it keeps an inset only if both had it.
       if (!insets.empty()) insets.back() = std::min(insets.back(), piece.edge_inset[i]);
@@ -399,10 +414,12 @@ void append_patches(const Patch& source, const Piece& piece, std::vector<Patch>&
     const auto* first = index.begin();
     for (size_t e = 0; e < k; ++e) {
       const size_t a = first[e], b = first[(e + 1) % k];
-      p.edge_inset[e] = (a + 1) % n == b ? insets[a] : 0.0f;  // along the piece's outline, not a diagonal
+      p.edge_inset[e] =
+          (a + 1) % n == b ? insets[a] : 0.0f;  // along the piece's outline, not a diagonal
     }
     dvec3 area_normal(0.0);
-    for (size_t i = 1; i + 1 < k; ++i) area_normal += glm::cross(p.corners[i] - p.corners[0], p.corners[i + 1] - p.corners[0]);
+    for (size_t i = 1; i + 1 < k; ++i)
+      area_normal += glm::cross(p.corners[i] - p.corners[0], p.corners[i + 1] - p.corners[0]);
     p.area = 0.5 * glm::length(area_normal);
     p.sides = piece.sides;
     if (p.area > 0.0) out.push_back(p);
@@ -451,16 +468,18 @@ void mesh_contacts(Scene& scene) {
       box.hi += margin;
       near.clear();
       // A face that casts no shadow (a Blender light) neither cuts nor is cut.
-      if (patch.occludes) traverse_scene_bvh(
-          bvh,
-          [&](const Aabb& b) {
-            return b.lo.x <= box.hi.x && b.hi.x >= box.lo.x && b.lo.y <= box.hi.y && b.hi.y >= box.lo.y &&
-                   b.lo.z <= box.hi.z && b.hi.z >= box.lo.z;
-          },
-          [&](std::uint32_t t) {
-            const std::uint32_t q = owner[t];
-            if (q != p && patches[q].surface != patch.surface && patches[q].occludes) near.push_back(q);
-          });
+      if (patch.occludes)
+        traverse_scene_bvh(
+            bvh,
+            [&](const Aabb& b) {
+              return b.lo.x <= box.hi.x && b.hi.x >= box.lo.x && b.lo.y <= box.hi.y &&
+                     b.hi.y >= box.lo.y && b.lo.z <= box.hi.z && b.hi.z >= box.lo.z;
+            },
+            [&](std::uint32_t t) {
+              const std::uint32_t q = owner[t];
+              if (q != p && patches[q].surface != patch.surface && patches[q].occludes)
+                near.push_back(q);
+            });
       std::sort(near.begin(), near.end());
       near.erase(std::unique(near.begin(), near.end()), near.end());
 
@@ -478,13 +497,16 @@ void mesh_contacts(Scene& scene) {
           if (glm::length(segment.b - segment.a) > thinnest) cuts.push_back({segment, narrowest});
         if (c.meets) features.meetings.push_back({c.cuts[0], c.crosses});
         if (!c.cover_outline.empty()) {
-          features.covers.push_back({c.cover_outline, c.gap > std::max(touch_p, kCoincident * diameter[p]) ? c.gap : 0.0});
+          features.covers.push_back(
+              {c.cover_outline,
+               c.gap > std::max(touch_p, kCoincident * diameter[p]) ? c.gap : 0.0});
           if (c.coincident) coincident.emplace_back(q, std::move(c.cover_outline));
         }
       }
       Polygon2 whole;
       for (int k = 0; k < patch.corner_count; ++k)
-        whole.push_back({f.to2(patch.corners[static_cast<size_t>(k)]), patch.corners[static_cast<size_t>(k)]});
+        whole.push_back(
+            {f.to2(patch.corners[static_cast<size_t>(k)]), patch.corners[static_cast<size_t>(k)]});
       std::vector<Polygon2> pieces = cut_along(whole, std::move(cuts), thinnest);
       for (Polygon2& polygon : pieces) {
         Piece piece;
@@ -509,7 +531,8 @@ void mesh_contacts(Scene& scene) {
   for (auto& pieces : cut)
     for (Piece& piece : pieces) flat.push_back(&piece);
   const auto resolve = [&](std::int64_t index) {
-    while (flat[static_cast<size_t>(index)]->merged_into >= 0) index = flat[static_cast<size_t>(index)]->merged_into;
+    while (flat[static_cast<size_t>(index)]->merged_into >= 0)
+      index = flat[static_cast<size_t>(index)]->merged_into;
     return index;
   };
   std::vector<std::array<std::uint32_t, 2>> coincident;
@@ -536,13 +559,15 @@ void mesh_contacts(Scene& scene) {
       target = resolve(target);
       Piece& into = *flat[static_cast<size_t>(target)];
       const size_t owner_patch = static_cast<size_t>(
-          std::upper_bound(first_piece.begin(), first_piece.end(), static_cast<size_t>(target)) - first_piece.begin() - 1);
+          std::upper_bound(first_piece.begin(), first_piece.end(), static_cast<size_t>(target)) -
+          first_piece.begin() - 1);
       const bool same_facing = glm::dot(patches[p].normal, patches[owner_patch].normal) > 0.0;
       for (size_t s = 0; s < 2; ++s) {
         const PatchSide& side = piece.sides[s];
         if (!side.present) continue;
         PatchSide& there = into.sides[same_facing ? s : 1 - s];
-        const bool emits = luminance(side.emission) > 0.0, there_emits = luminance(there.emission) > 0.0;
+        const bool emits = luminance(side.emission) > 0.0,
+                   there_emits = luminance(there.emission) > 0.0;
         if (!there.present || (emits && !there_emits)) there = side;
       }
       piece.merged_into = target;
@@ -554,7 +579,8 @@ void mesh_contacts(Scene& scene) {
 
   scene.occluders.clear();
   for (size_t p = 0; p < n; ++p) {
-    const bool merged = std::all_of(cut[p].begin(), cut[p].end(), [](const Piece& piece) { return piece.merged_into >= 0; });
+    const bool merged = std::all_of(cut[p].begin(), cut[p].end(),
+                                    [](const Piece& piece) { return piece.merged_into >= 0; });
     if (!merged) scene.occluders.push_back(patches[p]);
   }
   std::vector<Patch> out;
@@ -578,7 +604,8 @@ void mesh_contacts(Scene& scene) {
       if (piece.merged_into < 0) append_patches(patches[p], piece, out);
   }
   std::sort(split_surfaces.begin(), split_surfaces.end());
-  scene.split_faces = static_cast<size_t>(std::unique(split_surfaces.begin(), split_surfaces.end()) - split_surfaces.begin());
+  scene.split_faces = static_cast<size_t>(
+      std::unique(split_surfaces.begin(), split_surfaces.end()) - split_surfaces.begin());
   patches = std::move(out);
 }
 

@@ -21,8 +21,8 @@
 // Each cut runs across the piece of P it passes through, so the pieces stay
 // convex; cuts that would leave a piece thinner than 1e-4 of P's diameter
 // are skipped, and so are faces (or lines of contact) smaller than 5 % of
-// P's diameter that do not emit (a chair leg on a floor). Where Q lies in P's plane (within 1e-5 of their diameters, or
-// 1e-6 of the scene's), the two coincide there: the coinciding pieces become
+// P's diameter that do not emit (a chair leg on a floor). Where Q lies in P's plane (within 1e-5 of
+// their diameters, or 1e-6 of the scene's), the two coincide there: the coinciding pieces become
 // one patch, with one side per direction (the emitting one, else the first
 // face's), so a doubled wall sends its light once; the pairs are listed in
 // Scene::coincident.

@@ -36,7 +36,8 @@ bool TailExtrapolation::after(Hierarchy& h, double residual, bool links_changed)
     last_ratio_ = 0.0;
     return false;
   }
-  const bool steady = ratio > kSlowRatio && ratio < 1.0 && std::abs(ratio - last_ratio_) < kRatioAgreement * ratio;
+  const bool steady =
+      ratio > kSlowRatio && ratio < 1.0 && std::abs(ratio - last_ratio_) < kRatioAgreement * ratio;
   last_ratio_ = ratio;
   steady_ = steady ? steady_ + 1 : 0;
   if (wait_ > 0) {

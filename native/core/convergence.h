@@ -31,8 +31,8 @@ class TailExtrapolation {
  private:
   std::vector<Rgb> previous_;  // radiance per element before the iteration
   double last_ratio_ = 0.0, last_residual_ = 0.0;
-  int steady_ = 0;   // iterations in a row with a steady ratio
-  int wait_ = 0;     // iterations to let pass after an extrapolation
+  int steady_ = 0;                // iterations in a row with a steady ratio
+  int wait_ = 0;                  // iterations to let pass after an extrapolation
   double residual_before_ = 0.0;  // of the iteration that extrapolated
   bool failed_ = false;           // an extrapolation made things worse
 };

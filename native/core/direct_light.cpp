@@ -9,8 +9,8 @@
 #include <string>
 
 #include "core/form_factor.h"
-#include "core/scene.h"
 #include "core/sampled_visibility.h"
+#include "core/scene.h"
 #include "core/shaft.h"
 #include "core/visible_polygon.h"
 
@@ -73,11 +73,12 @@ constexpr double kPointSun = 1e-4;
 // inside of a box's edge) is not let through as Embree's single-precision
 // margins would; past the crossover, Embree traverses the scene.
 template <typename Target>
-void shadow_rays(const SceneOccluders& occluders, std::span<const dvec3> receiver, std::uint32_t face,
-                 std::span<const dvec3> x, std::span<const dvec3> end, bool sampled, const Target& target,
-                 bool* blocked) {
-  const ShaftCulling culling = cull_shaft(occluders.shafts, receiver, face, end, kNoFace,
-                                          sampled ? kRayCrossover : std::numeric_limits<std::size_t>::max());
+void shadow_rays(const SceneOccluders& occluders, std::span<const dvec3> receiver,
+                 std::uint32_t face, std::span<const dvec3> x, std::span<const dvec3> end,
+                 bool sampled, const Target& target, bool* blocked) {
+  const ShaftCulling culling =
+      cull_shaft(occluders.shafts, receiver, face, end, kNoFace,
+                 sampled ? kRayCrossover : std::numeric_limits<std::size_t>::max());
   for (size_t s = 0; s < x.size(); ++s) {
     const dvec3 to = target(x[s]);
     if (culling.visibility == ShaftVisibility::hidden) {
@@ -117,13 +118,16 @@ std::string to_text(double v) {
 
 void check_light(const Light& light, std::size_t index) {
   const std::string which = "light " + std::to_string(index) + ": ";
-  const auto finite = [](const dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  const auto finite = [](const dvec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+  };
   for (int c = 0; c < 3; ++c)
     if (!(light.colour[c] >= 0.0 && light.colour[c] <= kMaxInputRadiance))
-      throw std::invalid_argument(which + "its colour (intensity) must lie in [0, " + to_text(kMaxInputRadiance) + "]");
+      throw std::invalid_argument(which + "its colour (intensity) must lie in [0, " +
+                                  to_text(kMaxInputRadiance) + "]");
   if (!(finite(light.position) && glm::length(light.position) <= kMaxCoordinate))
-    throw std::invalid_argument(which + "its position must be finite and within " + to_text(kMaxCoordinate) +
-                                " of the origin");
+    throw std::invalid_argument(which + "its position must be finite and within " +
+                                to_text(kMaxCoordinate) + " of the origin");
   if (!finite(light.direction) || !(glm::length(light.direction) > 0.0))
     throw std::invalid_argument(which + "its direction must be finite and not zero");
   if (!(std::isfinite(light.radius) && light.radius >= 0.0))
@@ -134,7 +138,8 @@ void check_light(const Light& light, std::size_t index) {
     throw std::invalid_argument(which + "a spot's cos_half_angle must lie in [-1, 1]");
   if (!(std::isfinite(light.blend_width) && light.blend_width >= 0.0))
     throw std::invalid_argument(which + "a spot's blend_width must be finite and >= 0");
-  if (light.kind == LightKind::Sky) throw std::invalid_argument(which + "the sky is the world colour, not a light");
+  if (light.kind == LightKind::Sky)
+    throw std::invalid_argument(which + "the sky is the world colour, not a light");
 }
 
 SpotFactor spot_factor(const Light& light, double c) {
@@ -155,8 +160,8 @@ SpotFactor spot_factor(const Light& light, double c) {
   return {s, ds};
 }
 
-DirectLight::DirectLight(const Hierarchy& hierarchy, const SceneOccluders& occluders, VisibilityMode visibility,
-                         int rays, Oracle oracle, double geometric_scale)
+DirectLight::DirectLight(const Hierarchy& hierarchy, const SceneOccluders& occluders,
+                         VisibilityMode visibility, int rays, Oracle oracle, double geometric_scale)
     : hierarchy_(hierarchy),
       occluders_(occluders),
       visibility_(visibility),
@@ -191,7 +196,8 @@ DirectLight::DirectLight(const Hierarchy& hierarchy, const SceneOccluders& occlu
         c[v] = vs[k];
         face[static_cast<size_t>(k)] = c;
       }
-      if (glm::dot(glm::cross(face[1] - face[0], face[2] - face[0]), normal) < 0.0) std::swap(face[1], face[3]);
+      if (glm::dot(glm::cross(face[1] - face[0], face[2] - face[0]), normal) < 0.0)
+        std::swap(face[1], face[3]);
       sky_[static_cast<size_t>(2 * axis + side)] = face;
     }
   }
@@ -201,8 +207,10 @@ std::vector<LightLink> DirectLight::initial_links() const {
   std::vector<LightLink> out;
   const std::size_t lights = hierarchy_.scene().lights.size();
   for (std::size_t r = 0; r < hierarchy_.root_count(); ++r) {
-    const std::int32_t root = hierarchy_.root(static_cast<std::uint32_t>(r / 2), static_cast<int>(r % 2));
-    if (root == kNone || !(luminance(hierarchy_.reflectance(hierarchy_.element(root))) > 0.0)) continue;
+    const std::int32_t root =
+        hierarchy_.root(static_cast<std::uint32_t>(r / 2), static_cast<int>(r % 2));
+    if (root == kNone || !(luminance(hierarchy_.reflectance(hierarchy_.element(root))) > 0.0))
+      continue;
     for (std::size_t l = 0; l < lights; ++l) {
       LightLink link;
       link.receiver = root;
@@ -214,8 +222,8 @@ std::vector<LightLink> DirectLight::initial_links() const {
 }
 
 template <typename PolygonAt>
-void DirectLight::disk_light(const Element& receiver, const PolygonAt& polygon_at, std::span<const dvec3> shaft,
-                             double scale, Values& out) const {
+void DirectLight::disk_light(const Element& receiver, const PolygonAt& polygon_at,
+                             std::span<const dvec3> shaft, double scale, Values& out) const {
   dvec3 corners[4], x[kMaxSamples];
   const int nc = hierarchy_.corners(receiver, corners);
   const int ns = hierarchy_.samples(receiver, x);
@@ -223,8 +231,8 @@ void DirectLight::disk_light(const Element& receiver, const PolygonAt& polygon_a
   const std::uint32_t face = hierarchy_.patch_of(receiver).surface;
   const bool sampled = visibility_ == VisibilityMode::Sampled;
   const ShaftCulling culling =
-      cull_shaft(occluders_.shafts, std::span<const dvec3>(corners, static_cast<size_t>(nc)), face, shaft, kNoFace,
-                 sampled ? kRayCrossover : std::numeric_limits<std::size_t>::max());
+      cull_shaft(occluders_.shafts, std::span<const dvec3>(corners, static_cast<size_t>(nc)), face,
+                 shaft, kNoFace, sampled ? kRayCrossover : std::numeric_limits<std::size_t>::max());
   if (culling.visibility == ShaftVisibility::hidden) return;
   std::vector<Triangle> candidates;
   if (!culling.truncated)
@@ -239,12 +247,15 @@ void DirectLight::disk_light(const Element& receiver, const PolygonAt& polygon_a
       f = visible_form_factor_gradient(x[s], n, emitter, candidates);
     } else {
       const SampledVisibilityOptions options{rays_, static_cast<std::uint64_t>(s)};
-      f = culling.truncated ? sampled_form_factor_gradient(x[s], n, emitter, *occluders_.rays, options, face)
-                            : sampled_form_factor_gradient(x[s], n, emitter, candidates, options);
+      f = culling.truncated
+              ? sampled_form_factor_gradient(x[s], n, emitter, *occluders_.rays, options, face)
+              : sampled_form_factor_gradient(x[s], n, emitter, candidates, options);
     }
     // Rounding where occluders meet (the edges of a closed box), not light: it
     // would light the inside of the box.
-    if (culling.visibility != ShaftVisibility::clear && !(f.value > kRounding * form_factor(x[s], n, emitter))) continue;
+    if (culling.visibility != ShaftVisibility::clear &&
+        !(f.value > kRounding * form_factor(x[s], n, emitter)))
+      continue;
     out.value[s] += scale * f.value;
     out.gradient[s] += scale * f.gradient;
   }
@@ -270,7 +281,9 @@ void DirectLight::point_or_spot(const Light& light, const Element& receiver, Val
     const DiskPolygon shaft = disk_polygon(p, glm::normalize(centre - p), 1.5 * widest);
     disk_light(
         receiver,
-        [&](const dvec3& at) { return disk_polygon(p, glm::normalize(at - p), disk_radius(glm::length(at - p))); },
+        [&](const dvec3& at) {
+          return disk_polygon(p, glm::normalize(at - p), disk_radius(glm::length(at - p)));
+        },
         shaft, 1.0 / (r * r), out);
   } else {
     dvec3 corners[4];
@@ -278,9 +291,10 @@ void DirectLight::point_or_spot(const Light& light, const Element& receiver, Val
     const dvec3 centre = hierarchy_.centre(receiver);
     const auto end = triangle_around(p, glm::normalize(centre - p), 1e-6 * glm::length(centre - p));
     bool blocked[kMaxSamples] = {};
-    shadow_rays(occluders_, std::span<const dvec3>(corners, static_cast<size_t>(nc)),
-                hierarchy_.patch_of(receiver).surface, std::span<const dvec3>(x, static_cast<size_t>(ns)), end,
-                visibility_ == VisibilityMode::Sampled, [&](const dvec3&) { return p; }, blocked);
+    shadow_rays(
+        occluders_, std::span<const dvec3>(corners, static_cast<size_t>(nc)),
+        hierarchy_.patch_of(receiver).surface, std::span<const dvec3>(x, static_cast<size_t>(ns)),
+        end, visibility_ == VisibilityMode::Sampled, [&](const dvec3&) { return p; }, blocked);
     for (int s = 0; s < ns; ++s) {
       const dvec3 d = p - x[s];
       const double d2 = glm::dot(d, d), nd = glm::dot(n, d);
@@ -313,11 +327,14 @@ void DirectLight::sun(const Light& light, const Element& receiver, Values& out) 
     if (c <= 0.0) return;
     dvec3 corners[4];
     const int nc = hierarchy_.corners(receiver, corners);
-    const auto end = triangle_around(hierarchy_.centre(receiver) - far_ * travel, travel, hierarchy_.diameter(receiver));
+    const auto end = triangle_around(hierarchy_.centre(receiver) - far_ * travel, travel,
+                                     hierarchy_.diameter(receiver));
     bool blocked[kMaxSamples] = {};
-    shadow_rays(occluders_, std::span<const dvec3>(corners, static_cast<size_t>(nc)),
-                hierarchy_.patch_of(receiver).surface, std::span<const dvec3>(x, static_cast<size_t>(ns)), end,
-                visibility_ == VisibilityMode::Sampled, [&](const dvec3& at) { return at - far_ * travel; }, blocked);
+    shadow_rays(
+        occluders_, std::span<const dvec3>(corners, static_cast<size_t>(nc)),
+        hierarchy_.patch_of(receiver).surface, std::span<const dvec3>(x, static_cast<size_t>(ns)),
+        end, visibility_ == VisibilityMode::Sampled,
+        [&](const dvec3& at) { return at - far_ * travel; }, blocked);
     for (int s = 0; s < ns; ++s)
       if (!blocked[s]) out.value[s] = c;
     return;
@@ -328,8 +345,8 @@ void DirectLight::sun(const Light& light, const Element& receiver, Values& out) 
                                          radius + hierarchy_.diameter(receiver));
   const double sin_half = std::sin(half);
   disk_light(
-      receiver, [&](const dvec3& at) { return disk_polygon(at - far_ * travel, travel, radius); }, shaft,
-      1.0 / (sin_half * sin_half), out);
+      receiver, [&](const dvec3& at) { return disk_polygon(at - far_ * travel, travel, radius); },
+      shaft, 1.0 / (sin_half * sin_half), out);
 }
 
 void DirectLight::sky(const Element& receiver, Values& out) const {
@@ -341,8 +358,9 @@ void DirectLight::sky(const Element& receiver, Values& out) const {
     for (const dvec3& c : face)
       for (int k = 0; k < nc; ++k) in_front |= glm::dot(n, c - corners[k]) > 0.0;
     if (!in_front) continue;
-    disk_light(receiver, [&](const dvec3&) { return face; }, std::span<const dvec3>(face.data(), face.size()), 1.0,
-               out);
+    disk_light(
+        receiver, [&](const dvec3&) { return face; },
+        std::span<const dvec3>(face.data(), face.size()), 1.0, out);
   }
 }
 
@@ -374,7 +392,8 @@ double DirectLight::probe(const Light& light, const Element& receiver) const {
         const double d2 = glm::dot(d, d);
         if (!(d2 > 0.0)) continue;
         const double len = std::sqrt(d2);
-        value = std::max(0.0, glm::dot(n, d)) / (d2 * len) * spot_factor(light, glm::dot(axis, -d / len)).value;
+        value = std::max(0.0, glm::dot(n, d)) / (d2 * len) *
+                spot_factor(light, glm::dot(axis, -d / len)).value;
         to = light.position;
       }
       if (value > largest && !occluders_.rays->occluded(x, to, face)) largest = value;
@@ -389,9 +408,15 @@ bool DirectLight::evaluate(LightLink& link) const {
   Values values;
   switch (light.kind) {
     case LightKind::Point:
-    case LightKind::Spot: point_or_spot(light, receiver, values); break;
-    case LightKind::Sun: sun(light, receiver, values); break;
-    case LightKind::Sky: sky(receiver, values); break;
+    case LightKind::Spot:
+      point_or_spot(light, receiver, values);
+      break;
+    case LightKind::Sun:
+      sun(light, receiver, values);
+      break;
+    case LightKind::Sky:
+      sky(receiver, values);
+      break;
   }
   dvec3 x[kMaxSamples];
   const int ns = hierarchy_.samples(receiver, x);

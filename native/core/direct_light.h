@@ -35,9 +35,9 @@ namespace radiosity {
 
 struct LightLink {
   std::int32_t receiver = kNone;
-  std::uint32_t light = 0;                       // index into Scene::lights
-  std::array<float, kMaxSamples> value{};        // H per unit colour, at each receiver sample
-  float oracle = 0.0f;  // geometric part of the oracle, as Link::oracle
+  std::uint32_t light = 0;                 // index into Scene::lights
+  std::array<float, kMaxSamples> value{};  // H per unit colour, at each receiver sample
+  float oracle = 0.0f;                     // geometric part of the oracle, as Link::oracle
   // Light the samples miss: the largest value on a 4 x 4 grid over the
   // receiver where it is more than twice the samples' largest (a spot's cone
   // or a sunlit patch falling between the corners and the centre of a wall),
@@ -48,8 +48,8 @@ struct LightLink {
 
 class DirectLight {
  public:
-  DirectLight(const Hierarchy& hierarchy, const SceneOccluders& occluders, VisibilityMode visibility,
-              int rays, Oracle oracle, double geometric_scale);
+  DirectLight(const Hierarchy& hierarchy, const SceneOccluders& occluders,
+              VisibilityMode visibility, int rays, Oracle oracle, double geometric_scale);
 
   // Fills the link's values and oracle for its receiver; false when no sample
   // receives any of the light.
@@ -74,8 +74,8 @@ class DirectLight {
   // or, sampled, from rays) for each sample; `polygon_at` builds the polygon
   // seen from a sample and `shaft` bounds every such polygon.
   template <typename PolygonAt>
-  void disk_light(const Element& receiver, const PolygonAt& polygon_at, std::span<const dvec3> shaft,
-                  double scale, Values& out) const;
+  void disk_light(const Element& receiver, const PolygonAt& polygon_at,
+                  std::span<const dvec3> shaft, double scale, Values& out) const;
 
   const Hierarchy& hierarchy_;
   const SceneOccluders& occluders_;

@@ -13,7 +13,8 @@ int child_centres(const Hierarchy& hierarchy, const Element& e, dvec3* out) {
   hierarchy.corners(e, c);
   if (e.corner_count == 4) {
     const dvec3 mid = 0.25 * (c[0] + c[1] + c[2] + c[3]);
-    for (int k = 0; k < 4; ++k) out[k] = 0.25 * (c[k] + 0.5 * (c[k] + c[(k + 1) % 4]) + mid + 0.5 * (c[k] + c[(k + 3) % 4]));
+    for (int k = 0; k < 4; ++k)
+      out[k] = 0.25 * (c[k] + 0.5 * (c[k] + c[(k + 1) % 4]) + mid + 0.5 * (c[k] + c[(k + 3) % 4]));
   } else {
     // Corner children are a half-size copy at each corner; the fourth is the middle one.
     const dvec3 centroid = (c[0] + c[1] + c[2]) / 3.0;
@@ -43,8 +44,8 @@ EmitterShape emitter_shape(const Hierarchy& hierarchy, const Element& emitter,
   return shape;
 }
 
-Rgb sent_radiance(const Hierarchy& hierarchy, std::int32_t emitter, const std::vector<Rgb>& radiance,
-                  const EmitterShape& shape) {
+Rgb sent_radiance(const Hierarchy& hierarchy, std::int32_t emitter,
+                  const std::vector<Rgb>& radiance, const EmitterShape& shape) {
   const Element& e = hierarchy.element(emitter);
   if (e.is_leaf() || !shape_computed(shape)) return radiance[static_cast<size_t>(emitter)];
   Rgb sum(0.0);

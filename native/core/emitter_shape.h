@@ -34,7 +34,7 @@ EmitterShape emitter_shape(const Hierarchy& hierarchy, const Element& emitter,
 // What `emitter` sends along a link of this shape: its radiance if it is a
 // leaf, else its children's radiances in the shape's shares (its own radiance
 // while the shape is not computed).
-Rgb sent_radiance(const Hierarchy& hierarchy, std::int32_t emitter, const std::vector<Rgb>& radiance,
-                  const EmitterShape& shape);
+Rgb sent_radiance(const Hierarchy& hierarchy, std::int32_t emitter,
+                  const std::vector<Rgb>& radiance, const EmitterShape& shape);
 
 }  // namespace radiosity

@@ -30,7 +30,8 @@ bool reflects(const Hierarchy& h, const Element& e) { return luminance(h.reflect
 // Per element, the fraction of its light that its own links deliver, as a
 // density over its area (a split emitter's share goes to its children as the
 // link's emitter shape says), then summed down to the leaves: D_l.
-std::vector<double> delivered_fractions(const Hierarchy& h, const std::vector<Link>& links, const ClusterTree& tree,
+std::vector<double> delivered_fractions(const Hierarchy& h, const std::vector<Link>& links,
+                                        const ClusterTree& tree,
                                         const std::vector<ClusterLink>& far) {
   const auto& elements = h.elements();
   std::vector<double> delivered(elements.size(), 0.0);
@@ -53,7 +54,8 @@ std::vector<double> delivered_fractions(const Hierarchy& h, const std::vector<Li
     for (int c = 0; c < 4; ++c) {
       const std::int32_t child = q.first_child + c;
       delivered[static_cast<size_t>(child)] +=
-          power * static_cast<double>(l.emitter_shape[static_cast<size_t>(c)]) / weights / h.element(child).area;
+          power * static_cast<double>(l.emitter_shape[static_cast<size_t>(c)]) / weights /
+          h.element(child).area;
     }
   }
   if (!far.empty()) {
@@ -66,7 +68,8 @@ std::vector<double> delivered_fractions(const Hierarchy& h, const std::vector<Li
       const dvec3 w(link.direction[0], link.direction[1], link.direction[2]);
       const Element& r = h.element(tree.sides()[tree.node(link.receiver).first]);
       const double cosine = std::max(0.0, -glm::dot(h.normal(r), w));
-      v[static_cast<size_t>(link.emitter)] += static_cast<double>(link.coupling) * cosine * r.area * w;
+      v[static_cast<size_t>(link.emitter)] +=
+          static_cast<double>(link.coupling) * cosine * r.area * w;
     }
     for (size_t i = 0; i < nodes.size(); ++i) {
       const ClusterNode& node = nodes[i];
@@ -76,13 +79,15 @@ std::vector<double> delivered_fractions(const Hierarchy& h, const std::vector<Li
       }
       for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
         const std::int32_t side = tree.sides()[k];
-        delivered[static_cast<size_t>(side)] += std::max(0.0, glm::dot(h.normal(h.element(side)), v[i]));
+        delivered[static_cast<size_t>(side)] +=
+            std::max(0.0, glm::dot(h.normal(h.element(side)), v[i]));
       }
     }
   }
   // Parents come before their children.
   for (size_t e = 0; e < elements.size(); ++e) {
-    if (elements[e].parent != kNone) delivered[e] += delivered[static_cast<size_t>(elements[e].parent)];
+    if (elements[e].parent != kNone)
+      delivered[e] += delivered[static_cast<size_t>(elements[e].parent)];
   }
   return delivered;
 }
@@ -117,7 +122,8 @@ void EnergyBalance::update(const Hierarchy& h, const LinkGather& grouping, const
   // receive too (reflect).
   std::vector<Rgb> partners(n);
   for (size_t e = 0; e < n; ++e) partners[e] = Rgb(1.0, reflects(h, elements[e]) ? 1.0 : 0.0, 0.0);
-  const LinkGather coverage{grouping.hierarchy, grouping.links, grouping.offset, grouping.order, partners};
+  const LinkGather coverage{grouping.hierarchy, grouping.links, grouping.offset, grouping.order,
+                            partners};
   std::vector<Rgb> far_coverage;
   if (!far.empty()) {
     far_coverage.resize(h.root_count());
@@ -134,16 +140,19 @@ void EnergyBalance::update(const Hierarchy& h, const LinkGather& grouping, const
   for (size_t e = known; e < n; ++e) {
     const Element& x = elements[e];
     if (x.parent == kNone) {
-      for (size_t s = 0; s < kMaxSamples; ++s) closure_[e][s] = static_cast<float>(at_leaves[e][s].x);
+      for (size_t s = 0; s < kMaxSamples; ++s)
+        closure_[e][s] = static_cast<float>(at_leaves[e][s].x);
       continue;
     }
     const Element& parent = elements[static_cast<size_t>(x.parent)];
     if (static_cast<std::int32_t>(e) != parent.first_child) continue;  // siblings come together
     SampleRgb values{};
-    for (size_t s = 0; s < kMaxSamples; ++s) values[s] = Rgb(static_cast<double>(closure_[static_cast<size_t>(x.parent)][s]));
+    for (size_t s = 0; s < kMaxSamples; ++s)
+      values[s] = Rgb(static_cast<double>(closure_[static_cast<size_t>(x.parent)][s]));
     const std::array<SampleRgb, 4> children = push_to_children(h, parent, values);
     for (size_t c = 0; c < 4; ++c)
-      for (size_t s = 0; s < kMaxSamples; ++s) closure_[e + c][s] = static_cast<float>(children[c][s].x);
+      for (size_t s = 0; s < kMaxSamples; ++s)
+        closure_[e + c][s] = static_cast<float>(children[c][s].x);
   }
 
   // Per leaf sample of a closed top-level element, the factor on what the
@@ -159,7 +168,8 @@ void EnergyBalance::update(const Hierarchy& h, const LinkGather& grouping, const
     if (root == kNone) continue;
     const Element& x = h.element(root);
     bool closed = true;
-    for (int s = 0; s < x.sample_count(); ++s) closed &= closure_[static_cast<size_t>(root)][static_cast<size_t>(s)] >= kClosed;
+    for (int s = 0; s < x.sample_count(); ++s)
+      closed &= closure_[static_cast<size_t>(root)][static_cast<size_t>(s)] >= kClosed;
     closed_root[r] = closed ? 1 : 0;
   }
   std::vector<double> receiving(n, 0.0);  // per leaf: closure over the surfaces that reflect
@@ -175,7 +185,8 @@ void EnergyBalance::update(const Hierarchy& h, const LinkGather& grouping, const
         const Rgb down = at_leaves[e][k] - own[k];
         double scale = 1.0;
         if (closed && down.x > kMinDownCoverage)
-          scale = std::clamp((static_cast<double>(closure_[e][k]) - own[k].x) / down.x, kDownScaleMin, kDownScaleMax);
+          scale = std::clamp((static_cast<double>(closure_[e][k]) - own[k].x) / down.x,
+                             kDownScaleMin, kDownScaleMax);
         down_scale_[e][k] = static_cast<float>(scale);
         received[k] = own[k] + scale * down;
       }
@@ -201,7 +212,9 @@ void EnergyBalance::update(const Hierarchy& h, const LinkGather& grouping, const
   }
   root_scale_.assign(h.root_count(), 1.0f);
   for (size_t r = 0; r < h.root_count(); ++r) {
-    if (sent[r] > 0.0) root_scale_[r] = static_cast<float>(std::clamp(closed[r] / sent[r], kRootScaleMin, kRootScaleMax));
+    if (sent[r] > 0.0)
+      root_scale_[r] =
+          static_cast<float>(std::clamp(closed[r] / sent[r], kRootScaleMin, kRootScaleMax));
   }
 }
 
@@ -217,7 +230,8 @@ void EnergyBalance::sent_radiances(const Hierarchy& h, std::vector<Rgb>& sent) c
     for (size_t r = range.begin(); r != range.end(); ++r) {
       const std::int32_t root = h.root(static_cast<std::uint32_t>(r / 2), static_cast<int>(r % 2));
       if (root != kNone)
-        send(h, root, h.element(root).radiance, static_cast<double>(root_scale_[r]), leaf_scale_, sent);
+        send(h, root, h.element(root).radiance, static_cast<double>(root_scale_[r]), leaf_scale_,
+             sent);
     }
   });
 }

@@ -72,8 +72,8 @@ class EnergyBalance {
  private:
   std::vector<SampleScale> closure_;     // per element, at its samples: all linked emitters
   std::vector<SampleScale> down_scale_;  // per element (leaves), at its samples
-  std::vector<float> leaf_scale_;        // C_l / D_l per element (1 where not balanced or not a leaf)
-  std::vector<float> root_scale_;        // lambda per root slot (2 patch + side)
+  std::vector<float> leaf_scale_;  // C_l / D_l per element (1 where not balanced or not a leaf)
+  std::vector<float> root_scale_;  // lambda per root slot (2 patch + side)
 };
 
 }  // namespace radiosity

@@ -66,9 +66,9 @@ class PolygonBuffer {
 // Receiver strictly in front of the polygon: above its plane by more than
 // every vertex is, and by more than the polygon's own thickness (a polygon
 // planar to 1e-9 of its size may have a corner 6e-9 long twisted by 30
-// degrees; from 3e-10 above it F was -6.5e-4: libFuzzer kernels, crash-dd8d717d). The normal comes from edges relative to v0 (Newell's method
-// on absolute coordinates fails for tiny, distant polygons). Heights are
-// measured the same way for the receiver and for the vertices, so what the
+// degrees; from 3e-10 above it F was -6.5e-4: libFuzzer kernels, crash-dd8d717d). The normal comes
+// from edges relative to v0 (Newell's method on absolute coordinates fails for tiny, distant
+// polygons). Heights are measured the same way for the receiver and for the vertices, so what the
 // normal gets wrong (its direction is only good to about eps / sin of the
 // polygon's sharpest fan angle: a sliver triangle 1e-5 wide tilts it by 1e-11)
 // and what a nearly planar polygon leaves off its plane move both alike: a
@@ -225,8 +225,8 @@ FormFactorGradient form_factor_gradient(const dvec3& r, const dvec3& n,
   if (polygon.size() < 3) return {};
   if (Rescaled moved = rescale(r, polygon); moved.scale != 0.0) {
     // r' = (r - r0) scale: dF/dr = scale dF/dr'.
-    FormFactorGradient g =
-        form_factor_gradient(dvec3(0.0), n, std::span<const dvec3>(moved.polygon.data(), polygon.size()));
+    FormFactorGradient g = form_factor_gradient(
+        dvec3(0.0), n, std::span<const dvec3>(moved.polygon.data(), polygon.size()));
     g.gradient *= moved.scale;
     return finite_or_zero(g);
   }

@@ -20,7 +20,7 @@
 namespace radiosity {
 
 struct FormFactorGradient {
-  double value = 0.0;  // F, dimensionless
+  double value = 0.0;   // F, dimensionless
   dvec3 gradient{0.0};  // dF/dr, per unit length
 };
 

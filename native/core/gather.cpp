@@ -11,15 +11,18 @@ namespace radiosity {
 
 SampleRgb LinkGather::operator()(std::int32_t e) const {
   SampleRgb h{};
-  for (std::uint32_t k = offset[static_cast<size_t>(e)]; k < offset[static_cast<size_t>(e) + 1]; ++k) {
+  for (std::uint32_t k = offset[static_cast<size_t>(e)]; k < offset[static_cast<size_t>(e) + 1];
+       ++k) {
     const Link& l = links[order[k]];
     const Rgb radiance = sent_radiance(hierarchy, l.emitter, source, l.emitter_shape);
-    for (size_t s = 0; s < kMaxSamples; ++s) h[s] += static_cast<double>(l.form_factor[s]) * radiance;
+    for (size_t s = 0; s < kMaxSamples; ++s)
+      h[s] += static_cast<double>(l.form_factor[s]) * radiance;
   }
   return h;
 }
 
-std::array<SampleRgb, 4> push_to_children(const Hierarchy& h, const Element& e, const SampleRgb& total) {
+std::array<SampleRgb, 4> push_to_children(const Hierarchy& h, const Element& e,
+                                          const SampleRgb& total) {
   const int corners = e.corner_count;
   // The children's interpolants do not reproduce the parent's bubble exactly:
   // a uniform shift makes them carry the same total.
@@ -56,8 +59,8 @@ SampleRgb far_down(const std::vector<Rgb>& far_light, std::int32_t root) {
   return down;
 }
 
-void gather_down(const Hierarchy& h, std::int32_t index, const SampleRgb& down, const LinkGather& gather,
-                 std::vector<SampleRgb>& out) {
+void gather_down(const Hierarchy& h, std::int32_t index, const SampleRgb& down,
+                 const LinkGather& gather, std::vector<SampleRgb>& out) {
   const Element& e = h.element(index);
   SampleRgb total = gather(index);
   for (size_t s = 0; s < kMaxSamples; ++s) total[s] += down[s];
@@ -66,7 +69,8 @@ void gather_down(const Hierarchy& h, std::int32_t index, const SampleRgb& down, 
     return;
   }
   const std::array<SampleRgb, 4> children = push_to_children(h, e, total);
-  for (int c = 0; c < 4; ++c) gather_down(h, e.first_child + c, children[static_cast<size_t>(c)], gather, out);
+  for (int c = 0; c < 4; ++c)
+    gather_down(h, e.first_child + c, children[static_cast<size_t>(c)], gather, out);
 }
 
 struct Change {
@@ -88,12 +92,14 @@ Rgb PushPull::operator()(std::int32_t index, const SampleRgb& down, Change& chan
   SampleRgb total = gather(index);
   const bool scaled = e.is_leaf() && static_cast<size_t>(index) < down_scale.size();
   for (size_t s = 0; s < kMaxSamples; ++s)
-    total[s] += scaled ? static_cast<double>(down_scale[static_cast<size_t>(index)][s]) * down[s] : down[s];
+    total[s] +=
+        scaled ? static_cast<double>(down_scale[static_cast<size_t>(index)][s]) * down[s] : down[s];
   if (static_cast<size_t>(index) < direct.size())
     for (size_t s = 0; s < kMaxSamples; ++s) total[s] += direct[static_cast<size_t>(index)][s];
   Rgb radiance;
   if (e.is_leaf()) {
-    radiance = h.emission(e) + h.reflectance(e) * glm::max(Interpolant::average(e.corner_count, total), Rgb(0.0));
+    radiance = h.emission(e) +
+               h.reflectance(e) * glm::max(Interpolant::average(e.corner_count, total), Rgb(0.0));
     change.delta += std::abs(luminance(radiance) - luminance(e.radiance)) * e.area;
     change.total += luminance(radiance) * e.area;
     if (leaf_out) (*leaf_out)[static_cast<size_t>(index)] = total;
@@ -116,9 +122,11 @@ Rgb PushPull::operator()(std::int32_t index, const SampleRgb& down, Change& chan
 }  // namespace
 
 std::vector<SampleRgb> gathered_at_leaves(const Hierarchy& h, const LinkGather& gather,
-                                              const std::vector<Rgb>& far_light) {
+                                          const std::vector<Rgb>& far_light) {
   std::vector<SampleRgb> out(h.elements().size());
-  for_each_root(h, [&](size_t, std::int32_t root) { gather_down(h, root, far_down(far_light, root), gather, out); });
+  for_each_root(h, [&](size_t, std::int32_t root) {
+    gather_down(h, root, far_down(far_light, root), gather, out);
+  });
   return out;
 }
 
@@ -127,7 +135,8 @@ double push_pull(Hierarchy& h, const LinkGather& gather, const std::vector<Rgb>&
                  std::vector<SampleRgb>* leaf_out) {
   std::vector<Change> changes(h.root_count());
   const PushPull visit{h, gather, down_scale, direct, leaf_out};
-  for_each_root(h, [&](size_t r, std::int32_t root) { visit(root, far_down(far_light, root), changes[r]); });
+  for_each_root(
+      h, [&](size_t r, std::int32_t root) { visit(root, far_down(far_light, root), changes[r]); });
   Change sum;
   for (const Change& c : changes) sum.delta += c.delta, sum.total += c.total;
   return sum.total > 0.0 ? sum.delta / sum.total : 0.0;

@@ -19,7 +19,8 @@ namespace radiosity {
 struct LinkGather {
   const Hierarchy& hierarchy;
   const std::vector<Link>& links;
-  const std::vector<std::uint32_t>& offset;  // links of element e: order[offset[e] .. offset[e + 1])
+  const std::vector<std::uint32_t>&
+      offset;  // links of element e: order[offset[e] .. offset[e + 1])
   const std::vector<std::uint32_t>& order;
   const std::vector<Rgb>& source;
 
@@ -33,14 +34,14 @@ using SampleScale = std::array<float, kMaxSamples>;
 // interpolant there, shifted uniformly so that the children carry the same
 // total as the parent (pushing light down neither makes nor loses energy).
 std::array<SampleRgb, 4> push_to_children(const Hierarchy& hierarchy, const Element& parent,
-                                              const SampleRgb& total);
+                                          const SampleRgb& total);
 
 // What every leaf gathers at its samples, its own links plus everything its
 // ancestors gathered pushed down, without touching radiances. `far_light`:
 // what each top-level element gathers through cluster links, uniform over
 // it (or empty). Indexed by element; zero for inner elements.
 std::vector<SampleRgb> gathered_at_leaves(const Hierarchy& hierarchy, const LinkGather& gather,
-                                              const std::vector<Rgb>& far_light);
+                                          const std::vector<Rgb>& far_light);
 
 // One push/pull over every root: each leaf's radiance becomes L_e + rho H
 // (H the interpolant's average of what it gathered), each inner element's the

@@ -96,7 +96,8 @@ Rgb Interpolant::average(int corner_count, const std::array<Rgb, kMaxSamples>& v
   glm::dvec3 corners(0.0);
   for (int k = 0; k < corner_count; ++k) corners += glm::dvec3(values[static_cast<size_t>(k)]);
   corners /= corner_count;
-  return Rgb((1 - bubble) * corners + bubble * glm::dvec3(values[static_cast<size_t>(corner_count)]));
+  return Rgb((1 - bubble) * corners +
+             bubble * glm::dvec3(values[static_cast<size_t>(corner_count)]));
 }
 
 namespace {
@@ -111,13 +112,16 @@ struct CornerKey {
   std::uint32_t corner_class;  // Patch::corner_class: which side of a discontinuity
   dvec3 position;
   bool operator==(const CornerKey& o) const {
-    return face == o.face && face_side == o.face_side && corner_class == o.corner_class && position == o.position;
+    return face == o.face && face_side == o.face_side && corner_class == o.corner_class &&
+           position == o.position;
   }
 };
 
 struct CornerHash {
   size_t operator()(const CornerKey& k) const {
-    size_t h = std::hash<std::uint64_t>()((static_cast<std::uint64_t>(k.face) << 33) ^ (static_cast<std::uint64_t>(k.corner_class) << 1) ^ k.face_side);
+    size_t h =
+        std::hash<std::uint64_t>()((static_cast<std::uint64_t>(k.face) << 33) ^
+                                   (static_cast<std::uint64_t>(k.corner_class) << 1) ^ k.face_side);
     for (int i = 0; i < 3; ++i) h = h * 1000003u ^ std::hash<double>()(k.position[i]);
     return h;
   }
@@ -142,8 +146,12 @@ Hierarchy::Hierarchy(const Scene& scene) : scene_(&scene) {
       const PatchSide& shown = patch.sides[static_cast<size_t>(side)];
       for (int k = 0; k < patch.corner_count; ++k) {
         const int source = side == 0 ? k : (patch.corner_count - k) % patch.corner_count;
-        const dvec3 corner = patch.corners[static_cast<size_t>(source)] + dvec3(0.0);  // no -0.0 in the key
-        const auto [it, made] = shared.try_emplace(CornerKey{shown.face, shown.face_side, patch.corner_class[static_cast<size_t>(source)], corner}, 0u);
+        const dvec3 corner =
+            patch.corners[static_cast<size_t>(source)] + dvec3(0.0);  // no -0.0 in the key
+        const auto [it, made] =
+            shared.try_emplace(CornerKey{shown.face, shown.face_side,
+                                         patch.corner_class[static_cast<size_t>(source)], corner},
+                               0u);
         if (made) it->second = add_vertex(corner);
         e.corner[static_cast<size_t>(k)] = it->second;
       }
@@ -241,11 +249,15 @@ std::int32_t Hierarchy::subdivide(std::int32_t index) {
     const std::uint32_t m01 = midpoint_or_add(c[0], c[1]), m12 = midpoint_or_add(c[1], c[2]);
     const std::uint32_t m23 = midpoint_or_add(c[2], c[3]), m30 = midpoint_or_add(c[3], c[0]);
     const std::uint32_t mid = add_vertex(centre(parent));
-    children = {{{c[0], m01, mid, m30}, {m01, c[1], m12, mid}, {mid, m12, c[2], m23}, {m30, mid, m23, c[3]}}};
+    children = {{{c[0], m01, mid, m30},
+                 {m01, c[1], m12, mid},
+                 {mid, m12, c[2], m23},
+                 {m30, mid, m23, c[3]}}};
   } else {
     const std::uint32_t m01 = midpoint_or_add(c[0], c[1]), m12 = midpoint_or_add(c[1], c[2]);
     const std::uint32_t m20 = midpoint_or_add(c[2], c[0]);
-    children = {{{c[0], m01, m20, 0}, {m01, c[1], m12, 0}, {m20, m12, c[2], 0}, {m12, m20, m01, 0}}};
+    children = {
+        {{c[0], m01, m20, 0}, {m01, c[1], m12, 0}, {m20, m12, c[2], 0}, {m12, m20, m01, 0}}};
   }
   const auto first = static_cast<std::int32_t>(elements_.size());
   for (int k = 0; k < 4; ++k) {

@@ -24,13 +24,13 @@ struct Light {
   //  sun: H on a surface facing the sun, H = E cos(theta);
   //  sky: the world's radiance, H = L_w times the form factor of the open sky.
   Rgb colour{0.0};
-  dvec3 position{0.0};               // point, spot
-  dvec3 direction{0.0, 0.0, -1.0};   // unit; spot: its axis; sun: the way its light travels
+  dvec3 position{0.0};              // point, spot
+  dvec3 direction{0.0, 0.0, -1.0};  // unit; spot: its axis; sun: the way its light travels
   // Point, spot: radius of the emitting sphere (Cycles 4.x), or of a disk
   // facing the receiver (`sphere` false: Cycles 3.x); 0 is a point.
   double radius = 0.0;
   bool sphere = true;
-  double angle = 0.0;                // sun: angular diameter of its disk, radians
+  double angle = 0.0;  // sun: angular diameter of its disk, radians
   // Spot: the factor on I in a direction at cosine c to the axis is
   // (c if cosine_falloff) x smoothstep((c - cos_half_angle) / blend_width),
   // a step where blend_width is 0.

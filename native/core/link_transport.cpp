@@ -1,8 +1,8 @@
 #include "core/link_transport.h"
 
 #include <algorithm>
-#include <cstdlib>
 #include <chrono>
+#include <cstdlib>
 #include <limits>
 #include <vector>
 
@@ -39,7 +39,8 @@ double distance_to_segment(const dvec3& p, const dvec3& a, const dvec3& b) {
 // Distance from p to a planar convex polygon (counter-clockwise about its normal).
 double distance_to_polygon(const dvec3& p, std::span<const dvec3> polygon) {
   const size_t k = polygon.size();
-  const dvec3 normal = glm::normalize(glm::cross(polygon[1] - polygon[0], polygon[k - 1] - polygon[0]));
+  const dvec3 normal =
+      glm::normalize(glm::cross(polygon[1] - polygon[0], polygon[k - 1] - polygon[0]));
   bool inside = true;
   double edge = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < k; ++i) {
@@ -87,8 +88,12 @@ struct LinkEnds {
   dvec3 receiver_corners[4], emitter_corners[4], x[kMaxSamples];
   int nr = 0, ne = 0, ns = 0;
   dvec3 n{0.0};
-  std::span<const dvec3> receiver_polygon() const { return {receiver_corners, static_cast<size_t>(nr)}; }
-  std::span<const dvec3> emitter_polygon() const { return {emitter_corners, static_cast<size_t>(ne)}; }
+  std::span<const dvec3> receiver_polygon() const {
+    return {receiver_corners, static_cast<size_t>(nr)};
+  }
+  std::span<const dvec3> emitter_polygon() const {
+    return {emitter_corners, static_cast<size_t>(ne)};
+  }
 };
 
 LinkEnds link_ends(const Hierarchy& h, const Element& receiver, const Element& emitter) {
@@ -145,7 +150,8 @@ FormFactorGradient unoccluded(const LinkEvaluator& evaluator, const dvec3& x, co
 // light a hair under it delivered 3 % less than its closure). On such
 // receivers, with exact visibility, the share comes from a 4 x 4 grid of
 // points over the element instead.
-double grid_visible_share(const LinkEnds& ends, int corner_count, std::span<const Triangle> occluders) {
+double grid_visible_share(const LinkEnds& ends, int corner_count,
+                          std::span<const Triangle> occluders) {
   double visible = 0.0, open = 0.0;
   const dvec3* c = ends.receiver_corners;
   for (int i = 0; i < 4; ++i) {
@@ -165,12 +171,13 @@ double grid_visible_share(const LinkEnds& ends, int corner_count, std::span<cons
   return open > 0.0 ? visible / open : -1.0;
 }
 
-void conserve_energy(const Element& receiver, const LinkEnds& ends, bool unoccluded, SampleValues& values,
-                     const std::span<const Triangle>* grid_occluders) {
+void conserve_energy(const Element& receiver, const LinkEnds& ends, bool unoccluded,
+                     SampleValues& values, const std::span<const Triangle>* grid_occluders) {
   std::array<Rgb, kMaxSamples> open{}, in_front{};
   double visible[kMaxSamples] = {};
   for (int s = 0; s < ends.ns; ++s) {
-    const double f = unoccluded ? values.value[s] : form_factor(ends.x[s], ends.n, ends.emitter_polygon());
+    const double f =
+        unoccluded ? values.value[s] : form_factor(ends.x[s], ends.n, ends.emitter_polygon());
     open[static_cast<size_t>(s)] = Rgb(f);
     in_front[static_cast<size_t>(s)] = Rgb(f > 0.0 ? 1.0 : 0.0);
     visible[s] = f > 0.0 ? std::clamp(values.value[s] / f, 0.0, 1.0) : 0.0;
@@ -181,7 +188,8 @@ void conserve_energy(const Element& receiver, const LinkEnds& ends, bool unocclu
   const double exact = patch_form_factor(ends.receiver_polygon(), ends.emitter_polygon(), 1e-8);
   if (!(average > 0.0) || !(exact >= 0.0) || !(front > 0.0)) return;
   bool all_seen = true;
-  for (int s = 0; s < ends.ns; ++s) all_seen &= open[static_cast<size_t>(s)].x <= 0.0 || visible[s] >= 1.0 - 1e-9;
+  for (int s = 0; s < ends.ns; ++s)
+    all_seen &= open[static_cast<size_t>(s)].x <= 0.0 || visible[s] >= 1.0 - 1e-9;
   if (!all_seen) {
     // Part hidden: the shift that corrects the open samples' average could
     // outweigh what the visible samples carry (a floor whose centre sample is
@@ -256,16 +264,20 @@ bool finish(const LinkEvaluator& evaluator, Link& link, const LinkEnds& ends, Sa
                       ends.n,
                       receiver.area,
                       hierarchy.diameter(receiver)};
-  link.oracle = used >= 2 ? static_cast<float>(oracle_geometry(evaluator.oracle, samples) / evaluator.geometric_scale) : 0.0f;
+  link.oracle = used >= 2 ? static_cast<float>(oracle_geometry(evaluator.oracle, samples) /
+                                               evaluator.geometric_scale)
+                          : 0.0f;
   timings.oracle += seconds_since(start);
 
   // The oracle judged the samples' shape; what is gathered also carries the
   // right total.
   const auto conserve_start = Clock::now();
   for (int s = 0; s < ends.ns; ++s) values.value[s] = std::max(0.0, values.value[s]);
-  const bool grid = !unoccluded && evaluator.visibility == VisibilityMode::Exact && hierarchy.has_insets(receiver);
+  const bool grid = !unoccluded && evaluator.visibility == VisibilityMode::Exact &&
+                    hierarchy.has_insets(receiver);
   conserve_energy(receiver, ends, unoccluded, values, grid ? &candidates : nullptr);
-  for (int s = 0; s < ends.ns; ++s) link.form_factor[static_cast<size_t>(s)] = static_cast<float>(values.value[s]);
+  for (int s = 0; s < ends.ns; ++s)
+    link.form_factor[static_cast<size_t>(s)] = static_cast<float>(values.value[s]);
   timings.form_factors += seconds_since(conserve_start);
   return true;
 }
@@ -283,7 +295,9 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo)
 
   auto start = Clock::now();
   // Shadow rays need no list of occluders: past the crossover, stop looking.
-  const std::size_t limit = visibility == VisibilityMode::Sampled ? kRayCrossover : std::numeric_limits<std::size_t>::max();
+  const std::size_t limit = visibility == VisibilityMode::Sampled
+                                ? kRayCrossover
+                                : std::numeric_limits<std::size_t>::max();
   const ShaftCulling culling =
       cull_shaft(occluders.shafts, ends.receiver_polygon(), hierarchy.patch_of(receiver).surface,
                  emitter_polygon, hierarchy.patch_of(emitter).surface, limit);
@@ -337,7 +351,8 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo)
     values.grad[s] = f.gradient;
   }
   timings.form_factors += seconds_since(start);
-  return finish(*this, link, ends, values, culling.visibility == ShaftVisibility::clear, timings, candidates);
+  return finish(*this, link, ends, values, culling.visibility == ShaftVisibility::clear, timings,
+                candidates);
 }
 
 void LinkEvaluator::evaluate_emitter_siblings(std::span<Link> links, LinkTimings& timings,
@@ -367,8 +382,8 @@ void LinkEvaluator::evaluate_emitter_siblings(std::span<Link> links, LinkTimings
   if (facing == 0) return;
 
   dvec3 parent_corners[4];
-  const std::span<const dvec3> parent_polygon(parent_corners,
-                                              static_cast<size_t>(hierarchy.corners(parent, parent_corners)));
+  const std::span<const dvec3> parent_polygon(
+      parent_corners, static_cast<size_t>(hierarchy.corners(parent, parent_corners)));
   auto start = Clock::now();
   const ShaftCulling culling =
       cull_shaft(occluders.shafts, ends[0].receiver_polygon(), hierarchy.patch_of(receiver).surface,
@@ -388,9 +403,10 @@ void LinkEvaluator::evaluate_emitter_siblings(std::span<Link> links, LinkTimings
     } else {
       ++timings.samples_occluded;
       timings.samples_shared += facing - 1;
-      visible_form_factor_gradient_parts(shared.x[s], shared.n, parent_polygon,
-                                         std::span<const std::span<const dvec3>>(parts.data(), facing),
-                                         candidates, std::span<FormFactorGradient>(f.data(), facing));
+      visible_form_factor_gradient_parts(
+          shared.x[s], shared.n, parent_polygon,
+          std::span<const std::span<const dvec3>>(parts.data(), facing), candidates,
+          std::span<FormFactorGradient>(f.data(), facing));
     }
     for (size_t k = 0; k < facing; ++k) {
       values[k].value[s] = f[k].value;
@@ -399,7 +415,10 @@ void LinkEvaluator::evaluate_emitter_siblings(std::span<Link> links, LinkTimings
   }
   timings.form_factors += seconds_since(start);
   for (size_t k = 0; k < facing; ++k)
-    visible[which[k]] = finish(*this, links[which[k]], ends[k], values[k], culling.visibility == ShaftVisibility::clear, timings, candidates) ? 1 : 0;
+    visible[which[k]] = finish(*this, links[which[k]], ends[k], values[k],
+                               culling.visibility == ShaftVisibility::clear, timings, candidates)
+                            ? 1
+                            : 0;
 }
 
 }  // namespace radiosity

@@ -14,9 +14,12 @@ std::optional<Oracle> parse_oracle(std::string_view name) {
 
 std::string_view oracle_name(Oracle oracle) {
   switch (oracle) {
-    case Oracle::Standard: return "standard";
-    case Oracle::Perceptual: return "perceptual";
-    case Oracle::Gradient: return "gradient";
+    case Oracle::Standard:
+      return "standard";
+    case Oracle::Perceptual:
+      return "perceptual";
+    case Oracle::Gradient:
+      return "gradient";
   }
   return "unknown";
 }
@@ -30,8 +33,7 @@ dvec3 tangential(const dvec3& g, const dvec3& normal) { return g - normal * glm:
 }  // namespace
 
 double perceptual_criterion(std::span<const dvec3> position, std::span<const double> value,
-                            std::span<const dvec3> gradient, const dvec3& normal,
-                            double diameter) {
+                            std::span<const dvec3> gradient, const dvec3& normal, double diameter) {
   const size_t n = position.size();
   double b_min = value[0], b_max = value[0], b_abs = 0.0;
   for (double b : value) {
@@ -94,9 +96,12 @@ double oracle_geometric_scale(Oracle oracle, double total_area) {
 
 double oracle_scale(Oracle oracle, double reference_radiance, double total_area) {
   switch (oracle) {
-    case Oracle::Standard: return reference_radiance * total_area;
-    case Oracle::Perceptual: return reference_radiance;
-    case Oracle::Gradient: return reference_radiance * std::sqrt(total_area);
+    case Oracle::Standard:
+      return reference_radiance * total_area;
+    case Oracle::Perceptual:
+      return reference_radiance;
+    case Oracle::Gradient:
+      return reference_radiance * std::sqrt(total_area);
   }
   return 1.0;
 }

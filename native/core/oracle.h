@@ -45,8 +45,7 @@ double oracle_geometry(Oracle oracle, const LinkSamples& samples);
 // the segment between samples, k from unit tangential gradients, and k_ij = 1
 // where a gradient is too small to have a direction.
 double perceptual_criterion(std::span<const dvec3> position, std::span<const double> value,
-                            std::span<const dvec3> gradient, const dvec3& normal,
-                            double diameter);
+                            std::span<const dvec3> gradient, const dvec3& normal, double diameter);
 
 // The oracle's scale in a scene, so thresholds are relative (DESIGN s3): with
 // reference radiance L_ref and total area A, Standard divides by L_ref A,

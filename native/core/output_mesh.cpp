@@ -2,12 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <glm/gtc/type_precision.hpp>
 #include <map>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
-
-#include <glm/gtc/type_precision.hpp>
 
 namespace radiosity {
 namespace {
@@ -33,7 +32,8 @@ class ForeignVertices {
   explicit ForeignVertices(const Hierarchy& h);
   // Appends, in order from a towards b, the foreign vertices strictly between
   // the consecutive vertices a and b of a polygon of the element under `root`.
-  void append_between(std::int32_t root, std::uint32_t a, std::uint32_t b, std::vector<std::uint32_t>& out) const;
+  void append_between(std::int32_t root, std::uint32_t a, std::uint32_t b,
+                      std::vector<std::uint32_t>& out) const;
 
  private:
   struct OnEdge {
@@ -41,13 +41,14 @@ class ForeignVertices {
     double t;
   };
   struct RootEdges {
-    std::unordered_map<std::uint32_t, std::vector<OnEdge>> own;  // its boundary vertices
+    std::unordered_map<std::uint32_t, std::vector<OnEdge>> own;            // its boundary vertices
     std::array<std::vector<std::pair<double, std::uint32_t>>, 4> foreign;  // per edge, sorted by t
   };
   std::unordered_map<std::int32_t, RootEdges> roots_;  // only roots that meet foreign vertices
 };
 
-void boundary_chain(const Hierarchy& h, std::uint32_t a, std::uint32_t b, std::vector<std::uint32_t>& out) {
+void boundary_chain(const Hierarchy& h, std::uint32_t a, std::uint32_t b,
+                    std::vector<std::uint32_t>& out) {
   out.push_back(a);
   append_hanging(h, a, b, out);
 }
@@ -75,7 +76,8 @@ ForeignVertices::ForeignVertices(const Hierarchy& h) {
     for (std::int32_t r : roots) {
       const Element& e = h.element(r);
       for (int k = 0; k < e.corner_count; ++k) {
-        const std::uint32_t a = e.corner[static_cast<size_t>(k)], b = e.corner[static_cast<size_t>((k + 1) % e.corner_count)];
+        const std::uint32_t a = e.corner[static_cast<size_t>(k)],
+                            b = e.corner[static_cast<size_t>((k + 1) % e.corner_count)];
         chain.clear();
         boundary_chain(h, a, b, chain);
         vertices.insert(vertices.end(), chain.begin(), chain.end());
@@ -86,9 +88,7 @@ ForeignVertices::ForeignVertices(const Hierarchy& h) {
     std::sort(vertices.begin(), vertices.end());
     vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
     const double cell = edge_sum / static_cast<double>(edges);
-    const auto cell_of = [&](const dvec3& p) {
-      return glm::i64vec3(glm::floor(p / cell));
-    };
+    const auto cell_of = [&](const dvec3& p) { return glm::i64vec3(glm::floor(p / cell)); };
     struct CellHash {
       size_t operator()(const glm::i64vec3& c) const {
         // Unsigned: the products of far cells overflow (UBSan, make fuzz's scene harness).
@@ -103,13 +103,15 @@ ForeignVertices::ForeignVertices(const Hierarchy& h) {
       RootEdges found;
       bool any = false;
       for (int k = 0; k < e.corner_count; ++k) {
-        const std::uint32_t a = e.corner[static_cast<size_t>(k)], b = e.corner[static_cast<size_t>((k + 1) % e.corner_count)];
+        const std::uint32_t a = e.corner[static_cast<size_t>(k)],
+                            b = e.corner[static_cast<size_t>((k + 1) % e.corner_count)];
         const dvec3 pa = h.vertex(a), ab = h.vertex(b) - pa;
         const double length2 = glm::dot(ab, ab);
         chain.clear();
         boundary_chain(h, a, b, chain);
         chain.push_back(b);
-        for (std::uint32_t v : chain) found.own[v].push_back({k, glm::dot(h.vertex(v) - pa, ab) / length2});
+        for (std::uint32_t v : chain)
+          found.own[v].push_back({k, glm::dot(h.vertex(v) - pa, ab) / length2});
         const double tolerance = 1e-9 * std::sqrt(length2);
         const glm::i64vec3 lo = cell_of(glm::min(pa, pa + ab) - dvec3(tolerance));
         const glm::i64vec3 hi = cell_of(glm::max(pa, pa + ab) + dvec3(tolerance));
@@ -173,7 +175,8 @@ OutputMesh make_output_mesh(const Hierarchy& h,
   const auto shown = [&](std::uint32_t patch, int side) {
     if (h.root(patch, side) == kNone) return false;
     if (lit[2 * patch + static_cast<size_t>(side)]) return true;
-    if (luminance(scene.patches[patch].sides[static_cast<size_t>(side)].emission) > 0.0) return true;
+    if (luminance(scene.patches[patch].sides[static_cast<size_t>(side)].emission) > 0.0)
+      return true;
     return side == 0 && !lit[2 * patch + 1];
   };
 
@@ -201,7 +204,8 @@ OutputMesh make_output_mesh(const Hierarchy& h,
 
   OutputMesh mesh;
   const auto append = [](std::vector<float>& out, const glm::dvec3& value) {
-    out.insert(out.end(), {static_cast<float>(value.x), static_cast<float>(value.y), static_cast<float>(value.z)});
+    out.insert(out.end(), {static_cast<float>(value.x), static_cast<float>(value.y),
+                           static_cast<float>(value.z)});
   };
   const auto radiance_at = [&](std::uint32_t v) {
     return sums[v].count ? sums[v].radiance / static_cast<double>(sums[v].count) : glm::dvec3(0.0);
@@ -223,7 +227,8 @@ OutputMesh make_output_mesh(const Hierarchy& h,
   const ForeignVertices foreign(h);
   std::vector<std::int32_t> root_of(elements.size());
   for (size_t i = 0; i < elements.size(); ++i)  // parents come before children
-    root_of[i] = elements[i].parent == kNone ? static_cast<std::int32_t>(i) : root_of[static_cast<size_t>(elements[i].parent)];
+    root_of[i] = elements[i].parent == kNone ? static_cast<std::int32_t>(i)
+                                             : root_of[static_cast<size_t>(elements[i].parent)];
   // A foreign vertex is placed where the other patch has it, with this
   // polygon's own radiance there (interpolated along its edge): the other
   // patch may lie across a discontinuity (contact.h), whose light must not
@@ -252,16 +257,17 @@ OutputMesh make_output_mesh(const Hierarchy& h,
         mesh.face_vertices.push_back(output_vertex(edge[j]));
         between.clear();
         foreign.append_between(root_of[i], edge[j], edge[j + 1], between);
-        for (std::uint32_t v : between) mesh.face_vertices.push_back(interpolated_vertex(v, edge[j], edge[j + 1]));
+        for (std::uint32_t v : between)
+          mesh.face_vertices.push_back(interpolated_vertex(v, edge[j], edge[j + 1]));
       }
     }
     mesh.face_sizes.push_back(static_cast<std::int32_t>(mesh.face_vertices.size() - polygon_start));
     mesh.source_face.push_back(static_cast<std::int32_t>(h.side_of(e).face));
     mesh.source_side.push_back(h.side_of(e).face_side);
     const Rgb mean = glm::max(Interpolant::average(e.corner_count, leaf_irradiance[i]), Rgb(0.0));
-    mesh.irradiance.insert(mesh.irradiance.end(), {static_cast<float>(mean.x),
-                                                   static_cast<float>(mean.y),
-                                                   static_cast<float>(mean.z)});
+    mesh.irradiance.insert(
+        mesh.irradiance.end(),
+        {static_cast<float>(mean.x), static_cast<float>(mean.y), static_cast<float>(mean.z)});
   }
   return mesh;
 }
@@ -278,15 +284,19 @@ void require_finite(const OutputMesh& mesh) {
     const auto size = static_cast<size_t>(mesh.face_sizes[p]);
     for (size_t k = 0; k < size && !what; ++k) {
       const auto v = static_cast<size_t>(mesh.face_vertices[corner + k]);
-      if (!finite(mesh.positions, 3 * v, 3)) what = "position";
-      else if (!finite(mesh.radiance, 3 * v, 3)) what = "radiance";
-      else if (!finite(mesh.vertex_irradiance, 3 * v, 3)) what = "vertex irradiance";
+      if (!finite(mesh.positions, 3 * v, 3))
+        what = "position";
+      else if (!finite(mesh.radiance, 3 * v, 3))
+        what = "radiance";
+      else if (!finite(mesh.vertex_irradiance, 3 * v, 3))
+        what = "vertex irradiance";
     }
     corner += size;
     if (what) {
-      throw std::runtime_error(std::string("the solve produced a non-finite ") + what + " on input face " +
-                               std::to_string(mesh.source_face[p]) + " (" + (mesh.source_side[p] ? "back" : "front") +
-                               " side, output polygon " + std::to_string(p) +
+      throw std::runtime_error(std::string("the solve produced a non-finite ") + what +
+                               " on input face " + std::to_string(mesh.source_face[p]) + " (" +
+                               (mesh.source_side[p] ? "back" : "front") + " side, output polygon " +
+                               std::to_string(p) +
                                "); this is a bug in the solver: nothing was written");
     }
   }

@@ -14,10 +14,10 @@
 namespace radiosity {
 
 struct OutputMesh {
-  std::vector<double> positions;          // 3 per vertex
+  std::vector<double> positions;            // 3 per vertex
   std::vector<std::int32_t> face_vertices;  // polygons' vertices, concatenated
   std::vector<std::int32_t> face_sizes;     // per polygon
-  std::vector<float> radiance;            // 3 per vertex
+  std::vector<float> radiance;              // 3 per vertex
   // Per vertex: the gathered H (irradiance / pi) before the surface's own
   // reflectance and emission, so radiance = L_e + rho H; what a lighting-only
   // bake multiplies a textured material's colour by.
@@ -26,7 +26,7 @@ struct OutputMesh {
   std::vector<std::uint8_t> source_side;  // per polygon: 0 front, 1 back
   // Per polygon: area average of the gathered H (irradiance / pi) over the
   // element, as the solver integrates it: absorbed power is pi (1 - rho) H A.
-  std::vector<float> irradiance;          // 3 per polygon
+  std::vector<float> irradiance;  // 3 per polygon
 
   std::size_t vertex_count() const { return positions.size() / 3; }
   std::size_t polygon_count() const { return face_sizes.size(); }

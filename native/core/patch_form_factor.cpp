@@ -150,7 +150,8 @@ constexpr std::array<double, 4> kGauss7W = {
 // cancel to 1 %), every interval would split down to depth 40, 2^40 of them.
 constexpr int kMaxSplits = 4096;
 template <class F>
-double gauss_kronrod(const F& f, double a, double b, double scale, double tolerance, int depth, int& splits) {
+double gauss_kronrod(const F& f, double a, double b, double scale, double tolerance, int depth,
+                     int& splits) {
   const double mid = 0.5 * (a + b), half = 0.5 * (b - a);
   double kronrod = kKronrodW[7] * f(mid), gauss = kGauss7W[3] * f(mid);
   for (int i = 0; i < 7; ++i) {
@@ -402,7 +403,8 @@ int far_order(double delta, double tolerance) {
 constexpr double kFarGap = 3.0;
 constexpr double kLopsided = 8.0;
 
-Polygon clipped(const Polygon& polygon, const dvec3& normal, const dvec3& point, double size, bool& any) {
+Polygon clipped(const Polygon& polygon, const dvec3& normal, const dvec3& point, double size,
+                bool& any) {
   std::array<dvec3, kCapacity> absolute;
   for (size_t i = 0; i < polygon.n; ++i) absolute[i] = polygon.origin + polygon.v[i];
   Plane plane;
@@ -414,7 +416,8 @@ Polygon clipped(const Polygon& polygon, const dvec3& normal, const dvec3& point,
 }
 
 // A_a F_ab = A_b F_ba of two clipped polygons facing each other.
-double exchange(const Polygon& a, const Plane& plane_a, const Polygon& b, const Plane& plane_b, double tolerance) {
+double exchange(const Polygon& a, const Plane& plane_a, const Polygon& b, const Plane& plane_b,
+                double tolerance) {
   const Ball ball_a = bounding_ball(a), ball_b = bounding_ball(b);
   const double gap = glm::length(ball_a.centre - ball_b.centre) - ball_a.radius - ball_b.radius;
   const bool a_smaller = ball_a.radius <= ball_b.radius;
@@ -422,8 +425,10 @@ double exchange(const Polygon& a, const Plane& plane_a, const Polygon& b, const 
   const Polygon& large = a_smaller ? b : a;
   const Plane& small_plane = a_smaller ? plane_a : plane_b;
   const Plane& large_plane = a_smaller ? plane_b : plane_a;
-  const double r = std::min(ball_a.radius, ball_b.radius), big = std::max(ball_a.radius, ball_b.radius);
-  if (gap >= kFarGap * r) return point_kernel_quadrature(small, small_plane.normal, large, far_order(gap / r, tolerance));
+  const double r = std::min(ball_a.radius, ball_b.radius),
+               big = std::max(ball_a.radius, ball_b.radius);
+  if (gap >= kFarGap * r)
+    return point_kernel_quadrature(small, small_plane.normal, large, far_order(gap / r, tolerance));
   if (big <= kLopsided * r) return contour_form(a, b);
   // The large polygon in pieces: four beyond the sides of a square of
   // half-width (kFarGap + 1) r about the small one's centre (in the large
@@ -466,7 +471,8 @@ double patch_form_factor(std::span<const dvec3> p, std::span<const dvec3> q, dou
   if (!(plane_p.twice_area > 0.0) || !(plane_q.twice_area > 0.0)) return 0.0;
 
   Polygon pc, qc;
-  if (!clip_to_front(p, plane_q, plane_p.size, pc) || !clip_to_front(q, plane_p, plane_q.size, qc)) {
+  if (!clip_to_front(p, plane_q, plane_p.size, pc) ||
+      !clip_to_front(q, plane_p, plane_q.size, qc)) {
     return 0.0;
   }
   // Slivers left by clipping carry no measurable exchange.

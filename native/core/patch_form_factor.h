@@ -43,6 +43,7 @@ namespace radiosity {
 // 1e-6 relative (1e-10 typical), including contact (shared edges or vertices),
 // coplanar polygons (0) and far-apart ones. `tolerance` sets the relative error
 // aimed at for far-apart pairs (fewer quadrature points when larger).
-double patch_form_factor(std::span<const dvec3> p, std::span<const dvec3> q, double tolerance = 1e-12);
+double patch_form_factor(std::span<const dvec3> p, std::span<const dvec3> q,
+                         double tolerance = 1e-12);
 
 }  // namespace radiosity

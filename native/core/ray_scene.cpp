@@ -49,7 +49,9 @@ RTCDevice shared_embree_device() {
     // face: refuse it.
     if (rtcGetDeviceProperty(d, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED) == 0) {
       rtcReleaseDevice(d);
-      throw std::runtime_error("Embree was built without filter functions (EMBREE_FILTER_FUNCTION=OFF); the solver needs them");
+      throw std::runtime_error(
+          "Embree was built without filter functions (EMBREE_FILTER_FUNCTION=OFF); the solver "
+          "needs them");
     }
     return d;
   }();
@@ -69,10 +71,12 @@ RayScene::RayScene(std::span<const Triangle> triangles, std::span<const std::uin
   rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
   if (!triangles.empty()) {
     RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-        geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * triangles.size()));
-    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-        geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), triangles.size()));
+    auto* vertices = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                3 * sizeof(float), 3 * triangles.size()));
+    auto* indices = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                3 * sizeof(unsigned), triangles.size()));
     if (!vertices || !indices) {
       rtcReleaseGeometry(geometry);
       rtcReleaseScene(scene_);

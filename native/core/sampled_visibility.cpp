@@ -124,9 +124,9 @@ namespace {
 // arrays that the compiler vectorises.
 struct CandidatesFromPoint {
   std::vector<double> e1x, e1y, e1z, e2x, e2y, e2z;  // triangle edges
-  std::vector<double> sx, sy, sz;                   // r - v0
-  std::vector<double> qx, qy, qz;                   // (r - v0) x e1
-  std::vector<double> tq;                           // e2 . q: t times det
+  std::vector<double> sx, sy, sz;                    // r - v0
+  std::vector<double> qx, qy, qz;                    // (r - v0) x e1
+  std::vector<double> tq;                            // e2 . q: t times det
 
   CandidatesFromPoint(std::span<const Triangle> candidates, const dvec3& r) {
     for (auto* v : {&e1x, &e1y, &e1z, &e2x, &e2y, &e2z, &sx, &sy, &sz, &qx, &qy, &qz, &tq})

@@ -41,7 +41,8 @@ double visible_fraction(const EmitterSamples& samples, std::span<const std::uint
 
 // Shadow rays through Embree, ignoring the link's own faces.
 double visible_fraction(const RayScene& scene, const dvec3& r, const EmitterSamples& samples,
-                        std::uint32_t receiver_face = kNoFace, std::uint32_t emitter_face = kNoFace);
+                        std::uint32_t receiver_face = kNoFace,
+                        std::uint32_t emitter_face = kNoFace);
 
 // Shadow rays tested in double precision against a link's candidate occluders
 // (from shaft culling): no scene traversal, exact exclusion of the own faces.

@@ -1,17 +1,16 @@
 #include "core/scene.h"
 
-#include "core/contact.h"
-
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
+#include "core/contact.h"
+
 namespace radiosity {
 namespace {
 
 [[noreturn]] void fail(const std::string& message) { throw std::invalid_argument(message); }
-
 
 dvec3 polygon_area_normal(std::span<const dvec3> polygon) {
   dvec3 sum(0.0);
@@ -24,7 +23,8 @@ dvec3 polygon_area_normal(std::span<const dvec3> polygon) {
 double polygon_diameter(std::span<const dvec3> polygon) {
   double d = 0.0;
   for (size_t i = 0; i < polygon.size(); ++i) {
-    for (size_t j = i + 1; j < polygon.size(); ++j) d = std::max(d, glm::length(polygon[j] - polygon[i]));
+    for (size_t j = i + 1; j < polygon.size(); ++j)
+      d = std::max(d, glm::length(polygon[j] - polygon[i]));
   }
   return d;
 }
@@ -100,17 +100,21 @@ double bend(std::span<const dvec3> polygon, const dvec3& normal, double diameter
 bool turns(std::span<const dvec3> polygon, double diameter) {
   const size_t n = polygon.size();
   for (size_t i = 0; i < n; ++i) {
-    const dvec3 turn = glm::cross(polygon[(i + 1) % n] - polygon[i], polygon[(i + 2) % n] - polygon[(i + 1) % n]);
+    const dvec3 turn =
+        glm::cross(polygon[(i + 1) % n] - polygon[i], polygon[(i + 2) % n] - polygon[(i + 1) % n]);
     if (glm::length(turn) > kDegenerate * diameter * diameter) return true;
   }
   return false;
 }
 
-double cross2(dvec2 a, dvec2 b, dvec2 c) { return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x); }
+double cross2(dvec2 a, dvec2 b, dvec2 c) {
+  return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+}
 
 // Whether two edges that share no corner cross or touch, in the plane.
 bool edges_meet(dvec2 a, dvec2 b, dvec2 c, dvec2 d) {
-  const double d1 = cross2(a, b, c), d2 = cross2(a, b, d), d3 = cross2(c, d, a), d4 = cross2(c, d, b);
+  const double d1 = cross2(a, b, c), d2 = cross2(a, b, d), d3 = cross2(c, d, a),
+               d4 = cross2(c, d, b);
   const bool straddle_ab = (d1 > 0) != (d2 > 0) || d1 == 0 || d2 == 0;
   const bool straddle_cd = (d3 > 0) != (d4 > 0) || d3 == 0 || d4 == 0;
   return straddle_ab && straddle_cd && std::min(a.x, b.x) <= std::max(c.x, d.x) &&
@@ -139,7 +143,8 @@ std::vector<dvec2> project(std::span<const dvec3> polygon, const dvec3& n) {
   const dvec3 helper = std::abs(n.x) < 0.9 ? dvec3(1, 0, 0) : dvec3(0, 1, 0);
   const dvec3 t1 = glm::normalize(glm::cross(helper, n)), t2 = glm::cross(n, t1);
   std::vector<dvec2> p;
-  for (const dvec3& v : polygon) p.push_back({glm::dot(v - polygon[0], t1), glm::dot(v - polygon[0], t2)});
+  for (const dvec3& v : polygon)
+    p.push_back({glm::dot(v - polygon[0], t1), glm::dot(v - polygon[0], t2)});
   return p;
 }
 
@@ -204,7 +209,8 @@ void check_sizes(const SceneArrays& a) {
   for (size_t f = 0; f < faces; ++f) {
     const std::int64_t size = a.face_sizes[f];
     if (size < 3) {
-      fail("face_sizes[" + std::to_string(f) + "] = " + std::to_string(size) + ": a face needs at least 3 vertices");
+      fail("face_sizes[" + std::to_string(f) + "] = " + std::to_string(size) +
+           ": a face needs at least 3 vertices");
     }
     if (static_cast<std::uint64_t>(size) > a.face_vertices.size() - total) {
       fail("face_sizes adds up to more than the " + std::to_string(a.face_vertices.size()) +
@@ -226,8 +232,9 @@ void check_values(const SceneArrays& a) {
     }
     if (std::abs(a.positions[i]) > kMaxCoordinate) {
       std::ostringstream m;
-      m << "vertex " << i / 3 << " lies " << std::abs(a.positions[i]) << " from the origin; coordinates beyond "
-        << kMaxCoordinate << " cannot be solved (scale the scene down)";
+      m << "vertex " << i / 3 << " lies " << std::abs(a.positions[i])
+        << " from the origin; coordinates beyond " << kMaxCoordinate
+        << " cannot be solved (scale the scene down)";
       fail(m.str());
     }
   }
@@ -249,8 +256,10 @@ void check_values(const SceneArrays& a) {
   // A face that casts no shadow stands for a light (Blender's light objects):
   // it would receive light through surfaces it lies on, so it must not reflect.
   for (size_t f = 0; f < a.occludes.size(); ++f) {
-    if (a.occludes[f] == 0 && (a.reflectance[3 * f] > 0.0 || a.reflectance[3 * f + 1] > 0.0 || a.reflectance[3 * f + 2] > 0.0)) {
-      fail("face " + std::to_string(f) + " casts no shadow (occludes is False) but reflects: such a face stands for a "
+    if (a.occludes[f] == 0 && (a.reflectance[3 * f] > 0.0 || a.reflectance[3 * f + 1] > 0.0 ||
+                               a.reflectance[3 * f + 2] > 0.0)) {
+      fail("face " + std::to_string(f) +
+           " casts no shadow (occludes is False) but reflects: such a face stands for a "
            "light and must have reflectance 0");
     }
   }
@@ -258,7 +267,8 @@ void check_values(const SceneArrays& a) {
     const double e = a.emission[i];
     if (!std::isfinite(e) || e < 0.0 || e > kMaxInputRadiance) {
       std::ostringstream m;
-      m << "emission of face " << i / 3 << " is " << e << "; it must lie in [0, " << kMaxInputRadiance << "]";
+      m << "emission of face " << i / 3 << " is " << e << "; it must lie in [0, "
+        << kMaxInputRadiance << "]";
       fail(m.str());
     }
   }
@@ -297,7 +307,8 @@ Scene make_scene(const SceneArrays& a) {
   }
 
   // Faces too small to solve in floating point (scene.h).
-  const double smallest_face = std::max(kMinRelativeFaceSize * scene.diameter, kMinFaceSizeOfReach * reach);
+  const double smallest_face =
+      std::max(kMinRelativeFaceSize * scene.diameter, kMinFaceSizeOfReach * reach);
   size_t offset = 0;
   std::vector<dvec3> polygon;
   std::vector<std::array<size_t, 3>> triangles;
@@ -312,28 +323,33 @@ Scene make_scene(const SceneArrays& a) {
     offset += size;
     while (polygon.size() > 1 && polygon.front() == polygon.back()) polygon.pop_back();
     const size_t repeated = size - polygon.size();
-    PatchBuilder builder{scene,
-                         Rgb(a.reflectance[3 * f], a.reflectance[3 * f + 1], a.reflectance[3 * f + 2]),
-                         Rgb(a.emission[3 * f], a.emission[3 * f + 1], a.emission[3 * f + 2]),
-                         a.two_sided.empty() || a.two_sided[f] != 0, a.occludes.empty() || a.occludes[f] != 0,
-                         face};
+    PatchBuilder builder{
+        scene,
+        Rgb(a.reflectance[3 * f], a.reflectance[3 * f + 1], a.reflectance[3 * f + 2]),
+        Rgb(a.emission[3 * f], a.emission[3 * f + 1], a.emission[3 * f + 2]),
+        a.two_sided.empty() || a.two_sided[f] != 0,
+        a.occludes.empty() || a.occludes[f] != 0,
+        face};
     const double diameter = polygon_diameter(polygon);
     const dvec3 area_normal = polygon_area_normal(polygon);
     if (polygon.size() < 3 || !(glm::length(area_normal) > kDegenerate * diameter * diameter)) {
       const char* why = !(diameter > 0.0) ? "zero area (coincident vertices)"
-                        : turns(polygon, diameter) ? "its outline crosses itself"  // lobes that cancel
-                                                   : "zero area (collinear vertices)";
+                        : turns(polygon, diameter)
+                            ? "its outline crosses itself"  // lobes that cancel
+                            : "zero area (collinear vertices)";
       scene.skipped.push_back({face, why});
       continue;
     }
     if (diameter < smallest_face) {
       std::ostringstream m;
-      m << "too small to solve (" << diameter << " across, in a scene " << scene.diameter << " across)";
+      m << "too small to solve (" << diameter << " across, in a scene " << scene.diameter
+        << " across)";
       scene.skipped.push_back({face, m.str()});
       continue;
     }
     std::ostringstream repairs;
-    if (repeated) repairs << repeated << " repeated corner" << (repeated > 1 ? "s" : "") << " removed; ";
+    if (repeated)
+      repairs << repeated << " repeated corner" << (repeated > 1 ? "s" : "") << " removed; ";
     if (polygon.size() == 3 || (polygon.size() == 4 && is_convex_planar_quad(polygon))) {
       builder.add(polygon);
     } else {
@@ -351,8 +367,8 @@ Scene make_scene(const SceneArrays& a) {
       }
       const double bent = bend(polygon, normal, diameter);
       if (bent > kPlanar) {
-        repairs << "not planar (bends by " << 100.0 * bent << " % of its size): split into " << builder.made
-                << " planar triangles; ";
+        repairs << "not planar (bends by " << 100.0 * bent << " % of its size): split into "
+                << builder.made << " planar triangles; ";
       }
     }
     if (builder.made == 0) {
@@ -366,7 +382,9 @@ Scene make_scene(const SceneArrays& a) {
     }
   }
   if (scene.patches.empty()) {
-    fail("every face is degenerate or broken and was skipped (face " + std::to_string(scene.skipped.front().face) + ": " + scene.skipped.front().what + "); nothing to solve");
+    fail("every face is degenerate or broken and was skipped (face " +
+         std::to_string(scene.skipped.front().face) + ": " + scene.skipped.front().what +
+         "); nothing to solve");
   }
   mesh_contacts(scene);
   for (const Patch& p : scene.patches) {

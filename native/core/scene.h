@@ -39,12 +39,12 @@ inline constexpr double kMinFaceSizeOfReach = 1e-9;
 
 // Views on the caller's arrays (numpy, without copies).
 struct SceneArrays {
-  std::span<const double> positions;       // 3 per vertex
+  std::span<const double> positions;            // 3 per vertex
   std::span<const std::int64_t> face_vertices;  // all faces' vertex indices, concatenated
   std::span<const std::int64_t> face_sizes;     // vertices per face
-  std::span<const double> reflectance;     // 3 per face, in [0, 1]
-  std::span<const double> emission;        // 3 per face, radiance >= 0
-  std::span<const std::uint8_t> two_sided;  // per face, or empty: every face two-sided
+  std::span<const double> reflectance;          // 3 per face, in [0, 1]
+  std::span<const double> emission;             // 3 per face, radiance >= 0
+  std::span<const std::uint8_t> two_sided;      // per face, or empty: every face two-sided
   // Per face, or empty: every face casts shadows. Blender's lights do not
   // (Cycles lets light through them, measured): their polygons only emit.
   std::span<const std::uint8_t> occludes;
@@ -61,8 +61,8 @@ struct SceneArrays {
 // another face's, contact.h).
 struct PatchSide {
   bool present = false;
-  std::uint32_t face = 0;       // index of the input face
-  std::uint8_t face_side = 0;   // 0: that face's front, 1: its back
+  std::uint32_t face = 0;      // index of the input face
+  std::uint8_t face_side = 0;  // 0: that face's front, 1: its back
   Rgb reflectance{0.0};
   Rgb emission{0.0};
 };
@@ -77,7 +77,7 @@ struct Patch {
   // of a split face, the triangles of an n-gon), or for faces merged where
   // they coincide, the first of them.
   std::uint32_t surface = 0;
-  bool occludes = true;  // casts shadows and takes part in contact meshing
+  bool occludes = true;              // casts shadows and takes part in contact meshing
   std::array<PatchSide, 2> sides{};  // front, back
   // Where contact.h cut the patch along the outline of something lying on it
   // or a line where something meets it, the radiance is discontinuous:
@@ -116,9 +116,9 @@ struct Scene {
   std::size_t split_faces = 0;  // input faces split along what lies on or passes through them
   std::size_t face_count = 0;
   std::size_t vertex_count = 0;
-  double total_area = 0.0;          // one side of every patch
-  double emitted_power = 0.0;       // sum of luminance(L_e) x area over emitting sides
-  double diameter = 0.0;            // of the scene's bounding box
+  double total_area = 0.0;     // one side of every patch
+  double emitted_power = 0.0;  // sum of luminance(L_e) x area over emitting sides
+  double diameter = 0.0;       // of the scene's bounding box
   // Radiance the emitted power would give if spread over every surface: the
   // brightness scale that makes the oracles' thresholds relative (DESIGN s3).
   double reference_radiance() const { return emitted_power / total_area; }

@@ -114,16 +114,19 @@ void* create_inner(RTCThreadLocalAllocator alloc, unsigned int, void*) {
 }
 void set_children(void* node, void** children, unsigned int count, void*) {
   auto* inner = static_cast<EmbreeInner*>(node);
-  for (unsigned int i = 0; i < count && i < 2; ++i) inner->child[i] = static_cast<EmbreeNode*>(children[i]);
+  for (unsigned int i = 0; i < count && i < 2; ++i)
+    inner->child[i] = static_cast<EmbreeNode*>(children[i]);
 }
 void set_bounds(void*, const RTCBounds**, unsigned int, void*) {}  // recomputed in double
-void* create_leaf(RTCThreadLocalAllocator alloc, const RTCBuildPrimitive* prims, size_t count, void*) {
+void* create_leaf(RTCThreadLocalAllocator alloc, const RTCBuildPrimitive* prims, size_t count,
+                  void*) {
   // Leaves hold at most maxLeafSize triangles, unless the depth limit forced more.
   void* memory = rtcThreadLocalAlloc(alloc, sizeof(EmbreeLeaf) + count * sizeof(std::uint32_t), 16);
   auto* leaf = new (memory) EmbreeLeaf();
   leaf->leaf = true;
   leaf->count = static_cast<std::uint32_t>(count);
-  leaf->triangle = reinterpret_cast<std::uint32_t*>(static_cast<unsigned char*>(memory) + sizeof(EmbreeLeaf));
+  leaf->triangle =
+      reinterpret_cast<std::uint32_t*>(static_cast<unsigned char*>(memory) + sizeof(EmbreeLeaf));
   for (std::uint32_t i = 0; i < leaf->count; ++i) leaf->triangle[i] = prims[i].primID;
   return leaf;
 }

@@ -21,9 +21,8 @@ double signed_area(const Polygon2& p) {
 // Convex hull of 2D points, counter-clockwise (Andrew's monotone chain).
 Polygon2 convex_hull(Polygon2 p) {
   if (p.size() < 3) return {};
-  std::sort(p.begin(), p.end(), [](const dvec2& a, const dvec2& b) {
-    return a.x < b.x || (a.x == b.x && a.y < b.y);
-  });
+  std::sort(p.begin(), p.end(),
+            [](const dvec2& a, const dvec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
   Polygon2 hull(2 * p.size());
   std::size_t k = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -215,7 +214,8 @@ bool box_outside(const Shaft& shaft, const Aabb& box) {
 
 }  // namespace
 
-OccluderScene make_occluder_scene(std::vector<Triangle> triangles, std::vector<std::uint32_t> face) {
+OccluderScene make_occluder_scene(std::vector<Triangle> triangles,
+                                  std::vector<std::uint32_t> face) {
   OccluderScene scene;
   scene.triangles = std::move(triangles);
   if (face.size() != scene.triangles.size()) {
@@ -259,9 +259,11 @@ Shaft make_shaft(std::span<const dvec3> receiver, std::span<const dvec3> emitter
           plane.normal = -n;
           plane.offset = -(glm::dot(n, points[i]) + std::min(0.0, dmin));
         }
-        const bool duplicate = std::any_of(shaft.planes.begin(), shaft.planes.end(), [&](const ShaftPlane& q) {
-          return glm::dot(q.normal, plane.normal) > 1.0 - 1e-12 && std::abs(q.offset - plane.offset) <= tol;
-        });
+        const bool duplicate =
+            std::any_of(shaft.planes.begin(), shaft.planes.end(), [&](const ShaftPlane& q) {
+              return glm::dot(q.normal, plane.normal) > 1.0 - 1e-12 &&
+                     std::abs(q.offset - plane.offset) <= tol;
+            });
         if (!duplicate) shaft.planes.push_back(plane);
       }
   shaft.flat = !any_volume;

@@ -37,7 +37,8 @@ struct OccluderScene {
 };
 
 // `face` may be empty (every triangle its own face).
-OccluderScene make_occluder_scene(std::vector<Triangle> triangles, std::vector<std::uint32_t> face = {});
+OccluderScene make_occluder_scene(std::vector<Triangle> triangles,
+                                  std::vector<std::uint32_t> face = {});
 
 // A plane n . x = offset with unit n pointing out of the shaft.
 struct ShaftPlane {
@@ -64,7 +65,7 @@ enum class ShaftVisibility { clear, partial, hidden };
 struct ShaftCulling {
   ShaftVisibility visibility = ShaftVisibility::clear;
   std::vector<std::uint32_t> candidates;  // triangle indices into the scene
-  bool truncated = false;  // more than the limit: `candidates` holds only some
+  bool truncated = false;                 // more than the limit: `candidates` holds only some
 };
 
 // With a `limit`, stops once more candidates than that are found (for

@@ -17,10 +17,10 @@
 
 #include "core/cluster_links.h"
 #include "core/cluster_tree.h"
-#include "core/gather.h"
 #include "core/convergence.h"
 #include "core/direct_light.h"
 #include "core/energy_balance.h"
+#include "core/gather.h"
 
 namespace radiosity {
 namespace {
@@ -37,9 +37,12 @@ struct ThresholdRange {
 
 ThresholdRange threshold_range(Oracle oracle) {
   switch (oracle) {
-    case Oracle::Standard: return {1e-2, 1e-7};
-    case Oracle::Perceptual: return {1.0, 4e-3};
-    case Oracle::Gradient: return {1e-1, 2.5e-4};
+    case Oracle::Standard:
+      return {1e-2, 1e-7};
+    case Oracle::Perceptual:
+      return {1.0, 4e-3};
+    case Oracle::Gradient:
+      return {1e-1, 2.5e-4};
   }
   return {1.0, 1e-4};
 }
@@ -54,7 +57,8 @@ constexpr double kAdaptationCalibration = 0.52;
 // as if it left from its centroid, which errs more the larger it looks from
 // the receiver, so finer quality asks for more distance.
 double cluster_separation(const SolveOptions& options) {
-  return options.cluster_separation > 0.0 ? options.cluster_separation : 2.0 + 8.0 * options.quality;
+  return options.cluster_separation > 0.0 ? options.cluster_separation
+                                          : 2.0 + 8.0 * options.quality;
 }
 
 // Light a light link's samples miss (LightLink::missed) is refined for when it
@@ -75,7 +79,8 @@ std::size_t available_memory() {
     if (key == "MemAvailable:") return kilobytes * 1024;
   }
   const long pages = sysconf(_SC_AVPHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-  if (pages > 0 && page > 0) return static_cast<std::size_t>(pages) * static_cast<std::size_t>(page);
+  if (pages > 0 && page > 0)
+    return static_cast<std::size_t>(pages) * static_cast<std::size_t>(page);
   return std::numeric_limits<std::size_t>::max() / 2;
 }
 
@@ -92,8 +97,9 @@ class Solver {
         start_(Clock::now()),
         hierarchy_(scene),
         occluders_(make_scene_occluders(scene)),
-        evaluator_{hierarchy_, occluders_, options.visibility, options.rays, options.oracle,
-                   oracle_geometric_scale(options.oracle, scene.total_area)},
+        evaluator_{hierarchy_,         occluders_,
+                   options.visibility, options.rays,
+                   options.oracle,     oracle_geometric_scale(options.oracle, scene.total_area)},
         direct_(hierarchy_, occluders_, options.visibility, options.rays, options.oracle,
                 oracle_geometric_scale(options.oracle, scene.total_area)),
         min_area_(options.min_element_area * scene.total_area),
@@ -151,7 +157,7 @@ class Solver {
   // Links grouped by receiver for the gather, and which links they describe.
   std::vector<std::uint32_t> offset_, order_;
   std::vector<Rgb> source_;  // radiance per element as the last gather read it (what each sends)
-  EnergyBalance balance_;     // corrections of what is received and sent (energy_balance.h)
+  EnergyBalance balance_;    // corrections of what is received and sent (energy_balance.h)
   ClusterTree clusters_;
   std::vector<ClusterLink> cluster_links_;
   ClusterGather cluster_gather_;
@@ -162,7 +168,7 @@ class Solver {
   std::vector<SampleRgb> direct_light_;
   std::uint64_t light_version_ = 1, direct_version_ = 0;
   std::uint64_t links_version_ = 1, grouped_version_ = 0;
-  SolveResult result_;  // the last complete pass
+  SolveResult result_;       // the last complete pass
   bool budget_hit_ = false;  // max_elements or memory_limit reached
   bool memory_hit_ = false;
   bool cut_short_ = false;             // the last evaluate_links stopped before the end
@@ -194,7 +200,8 @@ void Solver::track_memory() {
                          cluster_gather_.memory_bytes() + far_light_.capacity() * sizeof(Rgb) +
                          balance_.memory_bytes() + direct_light_.capacity() * sizeof(SampleRgb);
   stats_.link_bytes = links_.capacity() * sizeof(Link) + order_.capacity() * sizeof(std::uint32_t) +
-                      cluster_links_.capacity() * sizeof(ClusterLink) + light_links_.capacity() * sizeof(LightLink);
+                      cluster_links_.capacity() * sizeof(ClusterLink) +
+                      light_links_.capacity() * sizeof(LightLink);
   stats_.peak_bytes = std::max(stats_.peak_bytes, stats_.element_bytes + stats_.link_bytes);
 }
 
@@ -210,9 +217,11 @@ std::vector<Link> Solver::evaluate_links(std::vector<Link>&& candidates) {
   const auto parent = [&](std::int32_t e) { return hierarchy_.element(e).parent; };
   const auto run_of = [&](const Link& a, const Link& b) {
     // Roots have no parent: they never come from one split.
-    if (a.emitter == b.emitter && parent(a.receiver) != kNone && parent(a.receiver) == parent(b.receiver))
+    if (a.emitter == b.emitter && parent(a.receiver) != kNone &&
+        parent(a.receiver) == parent(b.receiver))
       return Run::SiblingReceivers;
-    if (a.receiver == b.receiver && parent(a.emitter) != kNone && parent(a.emitter) == parent(b.emitter))
+    if (a.receiver == b.receiver && parent(a.emitter) != kNone &&
+        parent(a.emitter) == parent(b.emitter))
       return Run::SiblingEmitters;
     return Run::Single;
   };
@@ -220,7 +229,8 @@ std::vector<Link> Solver::evaluate_links(std::vector<Link>&& candidates) {
   std::vector<Run> group_kind;
   for (size_t i = 0; i < candidates.size(); ++i) {
     const Run run = i > 0 ? run_of(candidates[i - 1], candidates[i]) : Run::Single;
-    const bool continues = !group_start.empty() && i - group_start.back() < 4 && run != Run::Single &&
+    const bool continues = !group_start.empty() && i - group_start.back() < 4 &&
+                           run != Run::Single &&
                            (group_kind.back() == Run::Single || group_kind.back() == run);
     if (continues) {
       group_kind.back() = run;
@@ -243,8 +253,9 @@ std::vector<Link> Solver::evaluate_links(std::vector<Link>&& candidates) {
       for (size_t g = range.begin(); g != range.end(); ++g) {
         const size_t first = group_start[g], count = group_start[g + 1] - first;
         if (group_kind[g] == Run::SiblingEmitters) {
-          evaluator_.evaluate_emitter_siblings(std::span<Link>(candidates.data() + first, count), local,
-                                               std::span<std::uint8_t>(visible.data() + first, count));
+          evaluator_.evaluate_emitter_siblings(
+              std::span<Link>(candidates.data() + first, count), local,
+              std::span<std::uint8_t>(visible.data() + first, count));
           continue;
         }
         CornerMemo memo;
@@ -261,9 +272,9 @@ std::vector<Link> Solver::evaluate_links(std::vector<Link>&& candidates) {
     if (visible[i]) candidates[kept++] = candidates[i];
   }
   candidates.resize(kept);
-  stats_.peak_bytes = std::max(stats_.peak_bytes, hierarchy_.memory_bytes() +
-                                                      links_.capacity() * sizeof(Link) +
-                                                      candidates.capacity() * sizeof(Link));
+  stats_.peak_bytes =
+      std::max(stats_.peak_bytes, hierarchy_.memory_bytes() + links_.capacity() * sizeof(Link) +
+                                      candidates.capacity() * sizeof(Link));
   return std::move(candidates);
 }
 
@@ -272,7 +283,8 @@ std::vector<Link> Solver::evaluate_links(std::vector<Link>&& candidates) {
 std::vector<LightLink> Solver::evaluate_light_links(std::vector<LightLink>&& candidates) {
   std::vector<std::uint8_t> lit(candidates.size(), 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, candidates.size()), [&](const auto& range) {
-    for (size_t i = range.begin(); i != range.end(); ++i) lit[i] = direct_.evaluate(candidates[i]) ? 1 : 0;
+    for (size_t i = range.begin(); i != range.end(); ++i)
+      lit[i] = direct_.evaluate(candidates[i]) ? 1 : 0;
   });
   size_t kept = 0;
   for (size_t i = 0; i < candidates.size(); ++i)
@@ -289,19 +301,23 @@ std::vector<LightLink> Solver::evaluate_light_links(std::vector<LightLink>&& can
 void Solver::link_initially() {
   const auto start = Clock::now();
   // Progress: the walk is the first half of linking, evaluating face links the second.
-  InitialLinks initial = link_clusters(clusters_, hierarchy_, *occluders_.rays, cluster_separation(options_),
-                                       kClusterRays, [this] { return cancelled() || out_of_time(); },
-                                       [this](double done) { report("linking", 0.05 * done); });
+  InitialLinks initial = link_clusters(
+      clusters_, hierarchy_, *occluders_.rays, cluster_separation(options_), kClusterRays,
+      [this] { return cancelled() || out_of_time(); },
+      [this](double done) { report("linking", 0.05 * done); });
   stats_.seconds_clustering = std::chrono::duration<double>(Clock::now() - start).count();
   // In blocks, so cancellation and progress stay prompt for large scenes.
   const size_t block = 65536;
   std::vector<Link>& candidates = initial.elements;
-  for (size_t begin = 0; begin < candidates.size() && !cancelled() && !out_of_time(); begin += block) {
+  for (size_t begin = 0; begin < candidates.size() && !cancelled() && !out_of_time();
+       begin += block) {
     const size_t end = std::min(candidates.size(), begin + block);
-    std::vector<Link> visible = evaluate_links(std::vector<Link>(candidates.begin() + static_cast<std::ptrdiff_t>(begin),
-                                                                 candidates.begin() + static_cast<std::ptrdiff_t>(end)));
+    std::vector<Link> visible =
+        evaluate_links(std::vector<Link>(candidates.begin() + static_cast<std::ptrdiff_t>(begin),
+                                         candidates.begin() + static_cast<std::ptrdiff_t>(end)));
     links_.insert(links_.end(), visible.begin(), visible.end());
-    report("linking", 0.05 + 0.05 * static_cast<double>(end) / static_cast<double>(candidates.size()));
+    report("linking",
+           0.05 + 0.05 * static_cast<double>(end) / static_cast<double>(candidates.size()));
   }
   candidates = {};
   cluster_links_ = std::move(initial.clusters);
@@ -337,8 +353,10 @@ void Solver::drop_links_light_cannot_reach() {
   const size_t sides = hierarchy_.root_count();
   std::vector<std::uint8_t> reached(hierarchy_.elements().size(), 0);
   for (size_t r = 0; r < sides; ++r) {
-    const std::int32_t root = hierarchy_.root(static_cast<std::uint32_t>(r / 2), static_cast<int>(r % 2));
-    if (root != kNone && luminance(hierarchy_.emission(hierarchy_.element(root))) > 0.0) reached[static_cast<size_t>(root)] = 1;
+    const std::int32_t root =
+        hierarchy_.root(static_cast<std::uint32_t>(r / 2), static_cast<int>(r % 2));
+    if (root != kNone && luminance(hierarchy_.emission(hierarchy_.element(root))) > 0.0)
+      reached[static_cast<size_t>(root)] = 1;
   }
   for (const LightLink& l : light_links_) reached[static_cast<size_t>(l.receiver)] = 1;
   for (const ClusterLink& l : cluster_links_) {
@@ -380,7 +398,8 @@ bool Solver::near_field(const Link& link, bool receiver_end) const {
 double Solver::adaptation_radiance() const {
   double light = 0.0, area = 0.0;
   for (size_t r = 0; r < hierarchy_.root_count(); ++r) {
-    const std::int32_t root = hierarchy_.root(static_cast<std::uint32_t>(r / 2), static_cast<int>(r % 2));
+    const std::int32_t root =
+        hierarchy_.root(static_cast<std::uint32_t>(r / 2), static_cast<int>(r % 2));
     if (root == kNone) continue;
     const Element& e = hierarchy_.element(root);
     if (!e.has_links && !(luminance(hierarchy_.emission(e)) > 0.0)) continue;
@@ -419,7 +438,8 @@ bool Solver::refine(double threshold) {
     }
     std::vector<Split> decision(links_.size(), Split::None);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, links_.size()), [&](const auto& range) {
-      for (size_t i = range.begin(); i != range.end(); ++i) decision[i] = choose_split(links_[i], threshold);
+      for (size_t i = range.begin(); i != range.end(); ++i)
+        decision[i] = choose_split(links_[i], threshold);
     });
     // Subdivide in link order (deterministic), within the element budget.
     std::vector<Link> kept, fresh;
@@ -459,7 +479,8 @@ bool Solver::refine(double threshold) {
           const Element& receiver = hierarchy_.element(link.receiver);
           const Element& emitter = hierarchy_.element(link.emitter);
           const bool receiver_down = !receiver.is_leaf() && (all || near_field(link, true));
-          const bool emitter_down = !receiver_down && all && !emitter.is_leaf() && near_field(link, false);
+          const bool emitter_down =
+              !receiver_down && all && !emitter.is_leaf() && near_field(link, false);
           if (!receiver_down && !emitter_down) {
             staying.push_back(link);
             continue;
@@ -528,7 +549,8 @@ bool Solver::refine_light_links(double threshold) {
       // hundredth of the adaptation level) whatever the oracle: the oracle
       // can only judge what the samples see.
       const bool missed = brightness * l.missed > kMissedLight * reference_radiance_;
-      split[i] = p.is_leaf() && (missed || brightness / reference_radiance_ * l.oracle > threshold) &&
+      split[i] = p.is_leaf() &&
+                 (missed || brightness / reference_radiance_ * l.oracle > threshold) &&
                  can_split(l.receiver);
     }
   });
@@ -586,7 +608,8 @@ void Solver::group_links() {
   order_.resize(links_.size());
   order_.shrink_to_fit();
   std::vector<std::uint32_t> next(offset_.begin(), offset_.end() - 1);
-  for (std::uint32_t i = 0; i < links_.size(); ++i) order_[next[static_cast<size_t>(links_[i].receiver)]++] = i;
+  for (std::uint32_t i = 0; i < links_.size(); ++i)
+    order_[next[static_cast<size_t>(links_[i].receiver)]++] = i;
   // Only links whose emitter has been split need its shape.
   tbb::parallel_for(tbb::blocked_range<size_t>(0, links_.size()), [&](const auto& range) {
     for (size_t i = range.begin(); i != range.end(); ++i) {
@@ -595,17 +618,19 @@ void Solver::group_links() {
       if (emitter.is_leaf() || shape_computed(l.emitter_shape)) continue;
       dvec3 receiver[4];
       const int n = hierarchy_.corners(hierarchy_.element(l.receiver), receiver);
-      l.emitter_shape = emitter_shape(hierarchy_, emitter, std::span<const dvec3>(receiver, static_cast<size_t>(n)));
+      l.emitter_shape = emitter_shape(hierarchy_, emitter,
+                                      std::span<const dvec3>(receiver, static_cast<size_t>(n)));
     }
   });
-  balance_.update(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, clusters_, cluster_links_,
-                  cluster_gather_);
+  balance_.update(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, clusters_,
+                  cluster_links_, cluster_gather_);
   grouped_version_ = links_version_;
 }
 
 void Solver::gather_far_light() {
   if (cluster_links_.empty()) return;
-  far_light_.resize(static_cast<size_t>(scene_.patches.size()) * 2);  // top-level elements come first
+  far_light_.resize(static_cast<size_t>(scene_.patches.size()) *
+                    2);  // top-level elements come first
   cluster_gather_(clusters_, cluster_links_, hierarchy_, source_, far_light_);
 }
 
@@ -615,10 +640,9 @@ double Solver::gather_push_pull() {
   balance_.sent_radiances(hierarchy_, source_);
   gather_far_light();
   gather_direct_light();
-  return push_pull(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_, balance_.down_scale(),
-                   direct_light_);
+  return push_pull(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_,
+                   balance_.down_scale(), direct_light_);
 }
-
 
 // Refine, gather, push/pull until converged (or `max_iterations`). Returns the
 // last residual.
@@ -662,8 +686,8 @@ void Solver::snapshot(double threshold) {
   group_links();
   gather_far_light();
   gather_direct_light();
-  push_pull(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_, balance_.down_scale(),
-            direct_light_, &leaf);
+  push_pull(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_,
+            balance_.down_scale(), direct_light_, &leaf);
   result_.mesh = make_output_mesh(hierarchy_, leaf);
   stats_.threshold = threshold;
 }
@@ -762,8 +786,10 @@ SolveResult solve(const Scene& scene, const SolveOptions& options, const Progres
   if (options.time_budget && !(*options.time_budget > 0.0)) {
     throw std::invalid_argument("time_budget must be positive seconds");
   }
-  if (options.rays < 1 || options.rays > 65536) throw std::invalid_argument("rays must lie in [1, 65536]");
-  if (options.bounces && *options.bounces < 1) throw std::invalid_argument("bounces must be at least 1");
+  if (options.rays < 1 || options.rays > 65536)
+    throw std::invalid_argument("rays must lie in [1, 65536]");
+  if (options.bounces && *options.bounces < 1)
+    throw std::invalid_argument("bounces must be at least 1");
   if (options.threads && (*options.threads < 1 || *options.threads > kMaxThreads))
     throw std::invalid_argument("threads must lie in [1, " + std::to_string(kMaxThreads) + "]");
   if (!(options.min_element_area > 0.0 && options.min_element_area < 1.0)) {
@@ -774,13 +800,15 @@ SolveResult solve(const Scene& scene, const SolveOptions& options, const Progres
   const std::size_t needed = estimated_base_bytes(scene);
   if (needed > *checked.memory_limit) {
     std::ostringstream m;
-    m << "the scene needs about " << gigabytes(needed) << " GB before any refinement, more than the "
-      << gigabytes(*checked.memory_limit) << " GB the solve may use (" << scene.patches.size()
+    m << "the scene needs about " << gigabytes(needed)
+      << " GB before any refinement, more than the " << gigabytes(*checked.memory_limit)
+      << " GB the solve may use (" << scene.patches.size()
       << " planar pieces); solve fewer or simpler objects";
     throw InsufficientMemory(m.str());
   }
   tbb::task_arena arena(options.threads ? *options.threads : tbb::task_arena::automatic);
-  SolveResult result = arena.execute([&] { return Solver(scene, checked, progress, cancel).run(); });
+  SolveResult result =
+      arena.execute([&] { return Solver(scene, checked, progress, cancel).run(); });
   require_finite(result.mesh);
   return result;
 }

@@ -89,17 +89,17 @@ struct SolveStats {
   std::size_t light_links = 0;  // leaf and light pairs of direct light (direct_light.h)
   int passes = 0;
   int iterations = 0;
-  double residual = 0.0;     // relative change of the last iteration
-  double threshold = 0.0;    // of the last complete pass
+  double residual = 0.0;   // relative change of the last iteration
+  double threshold = 0.0;  // of the last complete pass
   std::size_t skipped_faces = 0;
   std::size_t repaired_faces = 0;  // solved after a repair (Scene::repaired)
   bool cancelled = false;
-  std::string stopped_by;    // "quality", "max_elements", "memory", "time_budget", "cancel"
+  std::string stopped_by;  // "quality", "max_elements", "memory", "time_budget", "cancel"
   double seconds = 0.0;
   double seconds_linking = 0.0;
   double seconds_clustering = 0.0;  // of linking: the walk over cluster pairs, with its rays
-  LinkTimings link_cpu;      // CPU seconds over all threads
-  double seconds_gather = 0.0;  // gather and push/pull, wall clock
+  LinkTimings link_cpu;             // CPU seconds over all threads
+  double seconds_gather = 0.0;      // gather and push/pull, wall clock
   std::size_t element_bytes = 0;
   std::size_t link_bytes = 0;
   std::size_t peak_bytes = 0;  // peak of the solver's own structures

@@ -5,9 +5,9 @@
 
 namespace radiosity {
 
+using glm::dmat3;
 using glm::dvec2;
 using glm::dvec3;
-using glm::dmat3;
 
 inline constexpr double kPi = 3.14159265358979323846;
 inline constexpr double kInvTwoPi = 1.0 / (2.0 * kPi);

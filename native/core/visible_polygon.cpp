@@ -266,7 +266,8 @@ EmitterFrame make_frame(std::span<const dvec3> emitter) {
 double diameter(std::span<const dvec3> poly) {
   double d = 0.0;
   for (std::size_t i = 0; i < poly.size(); ++i)
-    for (std::size_t j = i + 1; j < poly.size(); ++j) d = std::max(d, glm::length(poly[i] - poly[j]));
+    for (std::size_t j = i + 1; j < poly.size(); ++j)
+      d = std::max(d, glm::length(poly[i] - poly[j]));
   return d;
 }
 
@@ -342,7 +343,8 @@ bool project_occluder(std::span<const dvec3> poly, Workspace& w) {
     if (dd > 1e-24) {
       const double h1 = glm::dot(nt_unit, poly[0]), h2 = glm::dot(f.normal, f.origin);
       trace.line.point = (h1 * glm::cross(f.normal, trace.line.direction) +
-                          h2 * glm::cross(trace.line.direction, nt_unit)) / dd;
+                          h2 * glm::cross(trace.line.direction, nt_unit)) /
+                         dd;
     } else {
       trace.line.point = f.origin;
     }
@@ -355,7 +357,7 @@ bool project_occluder(std::span<const dvec3> poly, Workspace& w) {
   for (std::size_t i = 0; i < m; ++i) {
     const dvec3& x = w.space_a[i].x;
     const double depth = w.height_r - f.height(x);  // > 0 between r and the emitter
-    if (!(depth > 0.0)) return false;                // only at r itself: plane through r
+    if (!(depth > 0.0)) return false;               // only at r itself: plane through r
     w.occluder.push_back({f.to_plane(r + (x - r) * (w.height_r / depth)), w.space_a[i].tag});
   }
   // Counter-clockwise, like the pieces it is subtracted from: reverse the
@@ -403,10 +405,13 @@ void subtract_occluder(Workspace& w) {
   for (std::size_t i = 0; i < q.size(); ++i) w.halves[i] = edge_half_plane(q, i);
   w.next_pieces.clear();
   w.next_start.assign(1, 0);
-  const auto close_piece = [&] { w.next_start.push_back(static_cast<std::uint32_t>(w.next_pieces.size())); };
+  const auto close_piece = [&] {
+    w.next_start.push_back(static_cast<std::uint32_t>(w.next_pieces.size()));
+  };
   // Bounding boxes first: most pieces lie far from a given occluder, and the
   // box test is much cheaper than the separating-axis test.
-  dvec2 q_low(std::numeric_limits<double>::infinity()), q_high(-std::numeric_limits<double>::infinity());
+  dvec2 q_low(std::numeric_limits<double>::infinity()),
+      q_high(-std::numeric_limits<double>::infinity());
   for (const PlaneVertex& v : q) {
     q_low = glm::min(q_low, v.p);
     q_high = glm::max(q_high, v.p);
@@ -414,13 +419,15 @@ void subtract_occluder(Workspace& w) {
   q_low -= w.tol.plane;
   q_high += w.tol.plane;
   for (std::size_t piece = 0; piece + 1 < w.start.size(); ++piece) {
-    const std::span<const PlaneVertex> p(w.pieces.data() + w.start[piece], w.start[piece + 1] - w.start[piece]);
+    const std::span<const PlaneVertex> p(w.pieces.data() + w.start[piece],
+                                         w.start[piece + 1] - w.start[piece]);
     dvec2 p_low = p[0].p, p_high = p[0].p;
     for (const PlaneVertex& v : p) {
       p_low = glm::min(p_low, v.p);
       p_high = glm::max(p_high, v.p);
     }
-    const bool apart = p_high.x <= q_low.x || p_low.x >= q_high.x || p_high.y <= q_low.y || p_low.y >= q_high.y;
+    const bool apart =
+        p_high.x <= q_low.x || p_low.x >= q_high.x || p_high.y <= q_low.y || p_low.y >= q_high.y;
     if (apart || disjoint(p, q, w.halves, w.tol)) {
       w.next_pieces.insert(w.next_pieces.end(), p.begin(), p.end());
       close_piece();
@@ -533,7 +540,8 @@ bool merge_into_quad(const Triangle& a, const Triangle& b, double tol, dvec3 qua
     const double n_len = glm::length(n);
     if (!(n_len > 0.0) || std::abs(glm::dot(n / n_len, x - p)) > tol) return false;
     for (int i = 0; i < 4; ++i) {
-      const dvec3 turn = glm::cross(quad[(i + 1) % 4] - quad[i], quad[(i + 2) % 4] - quad[(i + 1) % 4]);
+      const dvec3 turn =
+          glm::cross(quad[(i + 1) % 4] - quad[i], quad[(i + 2) % 4] - quad[(i + 1) % 4]);
       if (!(glm::dot(turn, n) > 1e-12 * n_len * n_len)) return false;
     }
     return true;
@@ -555,7 +563,8 @@ bool compute_visible_pieces(const dvec3& r, const dvec3& n, std::span<const dvec
     // Two consecutive triangles that make a planar convex quad (a mesh quad split
     // in two) are one occluder: no cut along their shared diagonal.
     std::span<const dvec3> poly(occluders[i].v);
-    if (i + 1 < occluders.size() && merge_into_quad(occluders[i], occluders[i + 1], w.tol.space, quad)) {
+    if (i + 1 < occluders.size() &&
+        merge_into_quad(occluders[i], occluders[i + 1], w.tol.space, quad)) {
       poly = std::span<const dvec3>(quad, 4);
       ++i;
     }
@@ -606,7 +615,8 @@ struct PieceSum {
   }
   FormFactorGradient finish(double unoccluded) const {
     FormFactorGradient out = sum;
-    if (!std::isfinite(out.gradient.x) || !std::isfinite(out.gradient.y) || !std::isfinite(out.gradient.z))
+    if (!std::isfinite(out.gradient.x) || !std::isfinite(out.gradient.y) ||
+        !std::isfinite(out.gradient.z))
       out.gradient = dvec3(0.0);
     out.value = std::isfinite(out.value) ? std::clamp(out.value, 0.0, unoccluded) : 0.0;
     // Below a billionth of the unoccluded value what is left is rounding: an
@@ -680,7 +690,8 @@ FormFactorGradient visible_form_factor_gradient(const dvec3& r, const dvec3& n,
   return total.finish(unoccluded.value);
 }
 
-void visible_form_factor_gradient_parts(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter,
+void visible_form_factor_gradient_parts(const dvec3& r, const dvec3& n,
+                                        std::span<const dvec3> emitter,
                                         std::span<const std::span<const dvec3>> parts,
                                         std::span<const Triangle> occluders,
                                         std::span<FormFactorGradient> out) {
@@ -689,16 +700,19 @@ void visible_form_factor_gradient_parts(const dvec3& r, const dvec3& n, std::spa
   bool occluded = false;
   if (!compute_visible_pieces(r, n, emitter, occluders, w, occluded)) return;
   for (std::size_t i = 0; i < parts.size(); ++i)
-    out[i] = occluded ? part_form_factor_gradient(w, parts[i]) : form_factor_gradient(r, n, parts[i]);
+    out[i] =
+        occluded ? part_form_factor_gradient(w, parts[i]) : form_factor_gradient(r, n, parts[i]);
 }
 
 const char* planar_convex_problem(std::span<const dvec3> polygon) {
   const std::size_t n = polygon.size();
   dvec3 normal(0.0);
   double diameter = 0.0;
-  for (std::size_t i = 1; i + 1 < n; ++i) normal += glm::cross(polygon[i] - polygon[0], polygon[i + 1] - polygon[0]);
+  for (std::size_t i = 1; i + 1 < n; ++i)
+    normal += glm::cross(polygon[i] - polygon[0], polygon[i + 1] - polygon[0]);
   for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = i + 1; j < n; ++j) diameter = std::max(diameter, glm::length(polygon[i] - polygon[j]));
+    for (std::size_t j = i + 1; j < n; ++j)
+      diameter = std::max(diameter, glm::length(polygon[i] - polygon[j]));
   normal = glm::normalize(normal);
   for (const dvec3& v : polygon)
     if (std::abs(glm::dot(normal, v - polygon[0])) > 1e-9 * diameter) return "is not planar";
@@ -709,7 +723,8 @@ const char* planar_convex_problem(std::span<const dvec3> polygon) {
     const dvec3& a = polygon[i];
     const dvec3& b = polygon[(i + 1) % n];
     const dvec3& c = polygon[(i + 2) % n];
-    if (glm::dot(glm::cross(b - a, c - b), normal) < -1e-12 * diameter * diameter) return "is not convex";
+    if (glm::dot(glm::cross(b - a, c - b), normal) < -1e-12 * diameter * diameter)
+      return "is not convex";
   }
   return nullptr;
 }

@@ -71,7 +71,8 @@ FormFactorGradient visible_form_factor_gradient(const dvec3& r, const dvec3& n,
 // it): the visible region of the whole emitter is computed once, with
 // occluders that cover all the parts, and clipped to each part. out[i] is the
 // visible form factor of parts[i]; equal to one call per part up to rounding.
-void visible_form_factor_gradient_parts(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter,
+void visible_form_factor_gradient_parts(const dvec3& r, const dvec3& n,
+                                        std::span<const dvec3> emitter,
                                         std::span<const std::span<const dvec3>> parts,
                                         std::span<const Triangle> occluders,
                                         std::span<FormFactorGradient> out);

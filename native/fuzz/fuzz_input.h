@@ -18,8 +18,8 @@
 
 #include "core/form_factor.h"
 #include "core/scene.h"
-#include "core/visible_polygon.h"
 #include "core/vec.h"
+#include "core/visible_polygon.h"
 
 namespace radiosity::fuzz {
 
@@ -67,12 +67,15 @@ inline void require_finite(const dvec3& v, const char* what) {
   for (int k = 0; k < 3; ++k) require_finite(v[k], what);
 }
 
-inline bool finite(const dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+inline bool finite(const dvec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 // python/numpy_input.cpp, require_coordinates: finite and within
 // kMaxCoordinate, as a point, polygon or occluder of the kernels must be.
 inline bool in_range(const dvec3& v) {
-  return std::abs(v.x) <= kMaxCoordinate && std::abs(v.y) <= kMaxCoordinate && std::abs(v.z) <= kMaxCoordinate;
+  return std::abs(v.x) <= kMaxCoordinate && std::abs(v.y) <= kMaxCoordinate &&
+         std::abs(v.z) <= kMaxCoordinate;
 }
 
 // python/numpy_input.cpp, read_polygon: at least 3 vertices within range, not of zero area.
@@ -85,13 +88,16 @@ inline bool valid_polygon(std::span<const dvec3> polygon) {
   double diameter = 0.0;
   for (std::size_t i = 1; i + 1 < n; ++i)
     area_normal += glm::cross(polygon[i] - polygon[0], polygon[i + 1] - polygon[0]);
-  for (std::size_t i = 1; i < n; ++i) diameter = std::max(diameter, glm::length(polygon[i] - polygon[0]));
+  for (std::size_t i = 1; i < n; ++i)
+    diameter = std::max(diameter, glm::length(polygon[i] - polygon[0]));
   return glm::length(area_normal) > 1e-12 * diameter * diameter && diameter > 0.0 &&
          std::isfinite(glm::length(area_normal));
 }
 
 // python/bind_visibility.cpp, require_planar_convex.
-inline bool planar_convex(std::span<const dvec3> polygon) { return planar_convex_problem(polygon) == nullptr; }
+inline bool planar_convex(std::span<const dvec3> polygon) {
+  return planar_convex_problem(polygon) == nullptr;
+}
 
 // python/numpy_input.cpp, read_unit_vec3: finite, non-zero, normalised.
 inline bool unit_normal(const dvec3& v, dvec3& out) {
@@ -121,7 +127,8 @@ inline std::vector<dvec3> read_polygon(Reader& in, std::size_t max_vertices) {
   const dvec3 t1 = glm::normalize(glm::cross(helper, normal)), t2 = glm::cross(normal, t1);
   for (std::size_t i = 0; i < n; ++i) {
     // Angles in increasing order: counter-clockwise about the normal.
-    const double angle = 2.0 * kPi * (static_cast<double>(i) + (in.u8() / 256.0)) / static_cast<double>(n);
+    const double angle =
+        2.0 * kPi * (static_cast<double>(i) + (in.u8() / 256.0)) / static_cast<double>(n);
     polygon[i] = centre + radius * (std::cos(angle) * t1 + std::sin(angle) * t2);
   }
   return polygon;

@@ -53,10 +53,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     fuzz::require_finite(f, "patch_form_factor: F");
     // Between two planar convex polygons (what the solver passes) F is a
     // fraction: of what leaves p, the share that reaches q.
-    const bool proper = fuzz::valid_polygon(p) && fuzz::valid_polygon(q) && fuzz::planar_convex(p) &&
-                        fuzz::planar_convex(q);
+    const bool proper = fuzz::valid_polygon(p) && fuzz::valid_polygon(q) &&
+                        fuzz::planar_convex(p) && fuzz::planar_convex(q);
     // (-1e-20 at the rounding of a 1e-9 scene is no finding.)
-    if (proper && (f < -1e-12 || f > 1.0 + 1e-6)) fuzz::fail("patch_form_factor: F outside [0, 1]", f);
+    if (proper && (f < -1e-12 || f > 1.0 + 1e-6))
+      fuzz::fail("patch_form_factor: F outside [0, 1]", f);
   }
   return 0;
 }

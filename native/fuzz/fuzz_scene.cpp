@@ -82,7 +82,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return 0;  // a clean refusal
   }
   for (const Patch& p : scene.patches) {
-    for (int k = 0; k < p.corner_count; ++k) fuzz::require_finite(p.corners[static_cast<std::size_t>(k)], "patch corner");
+    for (int k = 0; k < p.corner_count; ++k)
+      fuzz::require_finite(p.corners[static_cast<std::size_t>(k)], "patch corner");
     fuzz::require_finite(p.normal, "patch normal");
     fuzz::require_finite(p.area, "patch area");
   }

@@ -24,7 +24,8 @@ using namespace radiosity;
 
 namespace {
 
-std::vector<Triangle> read_occluders(fuzz::Reader& in, const dvec3& point, std::span<const dvec3> emitter) {
+std::vector<Triangle> read_occluders(fuzz::Reader& in, const dvec3& point,
+                                     std::span<const dvec3> emitter) {
   const std::size_t m = in.count(48);
   dvec3 centre(0.0);
   for (const dvec3& v : emitter) centre += v / static_cast<double>(emitter.size());
@@ -57,7 +58,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   dvec3 normal;
   const bool normal_ok = fuzz::unit_normal(in.vec3(), normal);
   const std::vector<dvec3> emitter = fuzz::read_polygon(in, 12);
-  if (!normal_ok || !fuzz::in_range(point) || !fuzz::valid_polygon(emitter) || !fuzz::planar_convex(emitter))
+  if (!normal_ok || !fuzz::in_range(point) || !fuzz::valid_polygon(emitter) ||
+      !fuzz::planar_convex(emitter))
     return 0;
   const std::vector<Triangle> occluders = read_occluders(in, point, emitter);
 
@@ -75,7 +77,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (flags & 1) {
     // The emitter's fan triangles, as the parts of a split emitter.
     std::vector<std::array<dvec3, 3>> fan;
-    for (std::size_t i = 1; i + 1 < emitter.size(); ++i) fan.push_back({emitter[0], emitter[i], emitter[i + 1]});
+    for (std::size_t i = 1; i + 1 < emitter.size(); ++i)
+      fan.push_back({emitter[0], emitter[i], emitter[i + 1]});
     std::vector<std::span<const dvec3>> parts;
     for (const auto& t : fan) parts.emplace_back(t.data(), t.size());
     std::vector<FormFactorGradient> out(parts.size());

@@ -38,7 +38,8 @@ InputArray<std::int64_t> read_indices(const py::handle& object, const std::strin
       for (py::ssize_t i = 0; i < floats.size(); ++i) {
         const double v = floats.data()[i];
         if (!std::isfinite(v) || v != std::floor(v)) {
-          throw std::invalid_argument(name + " must hold integers (index " + std::to_string(i) + ")");
+          throw std::invalid_argument(name + " must hold integers (index " + std::to_string(i) +
+                                      ")");
         }
       }
     }
@@ -63,9 +64,11 @@ double read_number(const py::dict& light, const char* key, const std::string& wh
 // (lights.h); unknown keys are refused, so a misspelt one is not ignored.
 Light read_light(const py::handle& item, size_t index) {
   const std::string which = "lights[" + std::to_string(index) + "].";
-  if (!py::isinstance<py::dict>(item)) throw std::invalid_argument("lights[" + std::to_string(index) + "] must be a dict");
+  if (!py::isinstance<py::dict>(item))
+    throw std::invalid_argument("lights[" + std::to_string(index) + "] must be a dict");
   const auto light = py::reinterpret_borrow<py::dict>(item);
-  if (!light.contains("type")) throw std::invalid_argument(which + "type is missing ('point', 'spot' or 'sun')");
+  if (!light.contains("type"))
+    throw std::invalid_argument(which + "type is missing ('point', 'spot' or 'sun')");
   const auto kind = parse_light_kind(py::str(light["type"]).cast<std::string>());
   if (!kind) throw std::invalid_argument(which + "type must be 'point', 'spot' or 'sun'");
   Light out;
@@ -92,7 +95,8 @@ Light read_light(const py::handle& item, size_t index) {
     if (take("radius", false)) out.radius = read_number(light, "radius", which);
     if (take("shape", false)) {
       const std::string shape = py::str(light["shape"]).cast<std::string>();
-      if (shape != "sphere" && shape != "disk") throw std::invalid_argument(which + "shape must be 'sphere' or 'disk'");
+      if (shape != "sphere" && shape != "disk")
+        throw std::invalid_argument(which + "shape must be 'sphere' or 'disk'");
       out.sphere = shape == "sphere";
     }
     if (out.kind == LightKind::Spot) {
@@ -107,15 +111,17 @@ Light read_light(const py::handle& item, size_t index) {
   for (const auto& [key, value] : light) {
     const std::string name = py::str(key).cast<std::string>();
     if (std::find(allowed.begin(), allowed.end(), name) == allowed.end())
-      throw std::invalid_argument(which + name + " is not a setting of a " + py::str(light["type"]).cast<std::string>() + " light");
+      throw std::invalid_argument(which + name + " is not a setting of a " +
+                                  py::str(light["type"]).cast<std::string>() + " light");
   }
   return out;
 }
 
 Scene make_python_scene(const py::handle& positions, const py::handle& face_vertices,
                         const py::handle& face_sizes, const py::handle& reflectance,
-                        const py::handle& emission, const py::handle& two_sided, const py::handle& occludes,
-                        const py::handle& lights, const py::handle& world) {
+                        const py::handle& emission, const py::handle& two_sided,
+                        const py::handle& occludes, const py::handle& lights,
+                        const py::handle& world) {
   const auto p = read_array_of<double>(positions, "positions", {-1, 3});
   const auto fv = read_indices(face_vertices, "face_vertices");
   const auto fs = read_indices(face_sizes, "face_sizes");
@@ -194,9 +200,11 @@ py::dict stats_dict(const SolveStats& s) {
   d["element_bytes"] = s.element_bytes;
   d["link_bytes"] = s.link_bytes;
   d["peak_bytes"] = s.peak_bytes;
-  d["bytes_per_element"] = s.elements ? static_cast<double>(s.element_bytes) / static_cast<double>(s.elements) : 0.0;
+  d["bytes_per_element"] =
+      s.elements ? static_cast<double>(s.element_bytes) / static_cast<double>(s.elements) : 0.0;
   const std::size_t all_links = s.links + s.cluster_links;
-  d["bytes_per_link"] = all_links ? static_cast<double>(s.link_bytes) / static_cast<double>(all_links) : 0.0;
+  d["bytes_per_link"] =
+      all_links ? static_cast<double>(s.link_bytes) / static_cast<double>(all_links) : 0.0;
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   d["peak_rss_bytes"] = static_cast<std::size_t>(usage.ru_maxrss) * 1024;
@@ -224,7 +232,8 @@ PyResult to_python(SolveResult&& r) {
 Oracle read_oracle(const std::string& name) {
   const auto oracle = parse_oracle(name);
   if (!oracle) {
-    throw std::invalid_argument("oracle must be 'standard', 'perceptual' or 'gradient', got '" + name + "'");
+    throw std::invalid_argument("oracle must be 'standard', 'perceptual' or 'gradient', got '" +
+                                name + "'");
   }
   return *oracle;
 }
@@ -238,7 +247,8 @@ VisibilityMode read_visibility(const std::string& name) {
 // Python's integers are unbounded: a count is range-checked here, so that any
 // int gives ValueError, never a TypeError or a wrapped value.
 int read_count(const py::object& value, const char* name, std::int64_t lo, std::int64_t hi) {
-  const std::string range = std::string(name) + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  const std::string range = std::string(name) + " must be an integer in [" + std::to_string(lo) +
+                            ", " + std::to_string(hi) + "]";
   // Anything with __index__ (int, numpy integers); not floats.
   const auto index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
   if (!index) {
@@ -257,15 +267,16 @@ int read_count(const py::object& value, const char* name, std::int64_t lo, std::
 PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
                   const py::object& max_elements, std::optional<double> time_budget,
                   const std::string& visibility, const py::object& rays, const py::object& bounces,
-                  const py::object& threads, const py::object& progress,
-                  const py::object& cancel, double min_element_area, const std::string& leaf_links,
+                  const py::object& threads, const py::object& progress, const py::object& cancel,
+                  double min_element_area, const std::string& leaf_links,
                   std::optional<double> cluster_separation, const py::object& memory_limit) {
   SolveOptions options;
   options.oracle = read_oracle(oracle);
   options.quality = quality;
   constexpr std::int64_t kMaxCount = std::int64_t{1} << 62;
   if (!max_elements.is_none()) {
-    options.max_elements = static_cast<std::size_t>(read_count(max_elements, "max_elements", 1, INT32_MAX));
+    options.max_elements =
+        static_cast<std::size_t>(read_count(max_elements, "max_elements", 1, INT32_MAX));
   }
   options.time_budget = time_budget;
   options.visibility = read_visibility(visibility);
@@ -281,7 +292,8 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
   options.min_element_area = min_element_area;
   if (cluster_separation) {
     if (!(*cluster_separation > 1.0))
-      throw std::invalid_argument("cluster_separation must be greater than 1 (or inf: no cluster links)");
+      throw std::invalid_argument(
+          "cluster_separation must be greater than 1 (or inf: no cluster links)");
     options.cluster_separation = *cluster_separation;
   }
   if (leaf_links == "none") {
@@ -291,12 +303,14 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
   } else if (leaf_links == "all") {
     options.leaf_links = SolveOptions::LeafLinks::All;
   } else {
-    throw std::invalid_argument("leaf_links must be 'none', 'near' or 'all', got '" + leaf_links + "'");
+    throw std::invalid_argument("leaf_links must be 'none', 'near' or 'all', got '" + leaf_links +
+                                "'");
   }
 
   const CancelToken* token = nullptr;
   if (!cancel.is_none()) {
-    if (!py::isinstance<CancelToken>(cancel)) throw std::invalid_argument("cancel must be a CancelToken or None");
+    if (!py::isinstance<CancelToken>(cancel))
+      throw std::invalid_argument("cancel must be a CancelToken or None");
     token = cancel.cast<CancelToken*>();
   }
   if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
@@ -327,7 +341,9 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
       }
     };
   }
-  const CancelCheck cancelled = [&] { return callback_failed.load() || (token && token->flag.load()); };
+  const CancelCheck cancelled = [&] {
+    return callback_failed.load() || (token && token->flag.load());
+  };
   SolveResult result;
   {
     py::gil_scoped_release release;
@@ -341,79 +357,107 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
 
 void bind_solver(py::module_& m) {
   py::register_exception<InsufficientMemory>(m, "InsufficientMemoryError", PyExc_MemoryError);
-  py::class_<CancelToken>(m, "CancelToken",
-                          "A flag another thread can set to stop a solve; the solve then returns the "
-                          "last complete pass.")
+  py::class_<CancelToken>(
+      m, "CancelToken",
+      "A flag another thread can set to stop a solve; the solve then returns the "
+      "last complete pass.")
       .def(py::init<>())
-      .def("cancel", [](CancelToken& t) { t.flag = true; }, "Ask the solve to stop.")
+      .def(
+          "cancel", [](CancelToken& t) { t.flag = true; }, "Ask the solve to stop.")
       .def_property_readonly("cancelled", [](const CancelToken& t) { return t.flag.load(); });
 
-  py::class_<Scene>(m, "Scene",
-                    "Scene(positions, face_vertices, face_sizes, reflectance, emission, two_sided=None, occludes=None,\n"
-                    "      lights=None, world=None)\n\n"
-                    "positions (V, 3) float; face_vertices: all faces' vertex indices concatenated;\n"
-                    "face_sizes (F,) vertices per face (3 or more; larger polygons are triangulated);\n"
-                    "reflectance (F, 3) in [0, 1]; emission (F, 3) radiance >= 0; two_sided (F,) bool,\n"
-                    "default all True (a one-sided face has only its front: area lights); occludes (F,) bool,\n"
-                    "default all True (False: the face emits but casts no shadow and must not reflect, as Blender's lights).\n"
-                    "lights: list of dicts, each {'type': 'point', 'position', 'intensity' (H = I cos / d^2),\n"
-                    "'radius', 'shape': 'sphere' | 'disk'}, {'type': 'spot', the same and 'direction' (its axis),\n"
-                    "'cos_half_angle', 'blend_width', 'cosine_falloff'} or {'type': 'sun', 'direction' (the way\n"
-                    "its light travels), 'irradiance' (H facing it), 'angle' (radians)}; world (3,): the radiance of\n"
-                    "a uniform world, light from every direction that leaves the scene.\n"
-                    "Degenerate faces are skipped (skipped_faces), broken ones repaired (repaired_faces); bad input\n"
-                    "raises ValueError.")
+  py::class_<Scene>(
+      m, "Scene",
+      "Scene(positions, face_vertices, face_sizes, reflectance, emission, two_sided=None, "
+      "occludes=None,\n"
+      "      lights=None, world=None)\n\n"
+      "positions (V, 3) float; face_vertices: all faces' vertex indices concatenated;\n"
+      "face_sizes (F,) vertices per face (3 or more; larger polygons are triangulated);\n"
+      "reflectance (F, 3) in [0, 1]; emission (F, 3) radiance >= 0; two_sided (F,) bool,\n"
+      "default all True (a one-sided face has only its front: area lights); occludes (F,) bool,\n"
+      "default all True (False: the face emits but casts no shadow and must not reflect, as "
+      "Blender's lights).\n"
+      "lights: list of dicts, each {'type': 'point', 'position', 'intensity' (H = I cos / d^2),\n"
+      "'radius', 'shape': 'sphere' | 'disk'}, {'type': 'spot', the same and 'direction' (its "
+      "axis),\n"
+      "'cos_half_angle', 'blend_width', 'cosine_falloff'} or {'type': 'sun', 'direction' (the way\n"
+      "its light travels), 'irradiance' (H facing it), 'angle' (radians)}; world (3,): the "
+      "radiance of\n"
+      "a uniform world, light from every direction that leaves the scene.\n"
+      "Degenerate faces are skipped (skipped_faces), broken ones repaired (repaired_faces); bad "
+      "input\n"
+      "raises ValueError.")
       .def(py::init(&make_python_scene), py::arg("positions"), py::arg("face_vertices"),
            py::arg("face_sizes"), py::arg("reflectance"), py::arg("emission"),
-           py::arg("two_sided") = py::none(), py::arg("occludes") = py::none(), py::arg("lights") = py::none(),
-           py::arg("world") = py::none())
+           py::arg("two_sided") = py::none(), py::arg("occludes") = py::none(),
+           py::arg("lights") = py::none(), py::arg("world") = py::none())
       .def_property_readonly("face_count", [](const Scene& s) { return s.face_count; })
       .def_property_readonly("patch_count", [](const Scene& s) { return s.patches.size(); })
       .def_property_readonly("total_area", [](const Scene& s) { return s.total_area; })
-      .def_property_readonly("light_count", [](const Scene& s) { return s.lights.size(); },
-                             "lights solved as direct light: point, spot and sun lights, and the sky")
-      .def_property_readonly("skipped_faces", [](const Scene& s) {
-        py::list out;
-        for (const auto& k : s.skipped) out.append(py::make_tuple(k.face, k.what));
-        return out;
-      }, "(face, reason) of the input faces left out: zero area, or too small to solve")
-      .def_property_readonly("repaired_faces", [](const Scene& s) {
-        py::list out;
-        for (const auto& k : s.repaired) out.append(py::make_tuple(k.face, k.what));
-        return out;
-      }, "(face, what was done) of the input faces solved after a repair: repeated corners removed,\n"
-         "non-planar or self-crossing outlines split into triangles")
-      .def_property_readonly("coincident_faces", [](const Scene& s) {
-        py::list out;
-        for (const auto& pair : s.coincident) out.append(py::make_tuple(pair[0], pair[1]));
-        return out;
-      }, "pairs of input faces that coincide somewhere (each surface counted once)")
-      .def_property_readonly("split_faces", [](const Scene& s) { return s.split_faces; },
-                             "input faces split along what lies on or passes through them")
-      .def_property_readonly("patches", [](const Scene& s) {
-        py::list out;
-        for (const Patch& p : s.patches) {
-          py::list corners;
-          for (int k = 0; k < p.corner_count; ++k) {
-            const dvec3& c = p.corners[static_cast<size_t>(k)];
-            corners.append(py::make_tuple(c.x, c.y, c.z));
-          }
-          py::list sides;
-          for (const PatchSide& side : p.sides)
-            sides.append(side.present ? py::object(py::make_tuple(side.face, side.face_side)) : py::object(py::none()));
-          out.append(py::dict(py::arg("corners") = corners, py::arg("area") = p.area, py::arg("sides") = sides));
-        }
-        return out;
-      }, "the planar pieces solved: corners, area, and per side (front, back) the (face, face side) it shows or None");
+      .def_property_readonly(
+          "light_count", [](const Scene& s) { return s.lights.size(); },
+          "lights solved as direct light: point, spot and sun lights, and the sky")
+      .def_property_readonly(
+          "skipped_faces",
+          [](const Scene& s) {
+            py::list out;
+            for (const auto& k : s.skipped) out.append(py::make_tuple(k.face, k.what));
+            return out;
+          },
+          "(face, reason) of the input faces left out: zero area, or too small to solve")
+      .def_property_readonly(
+          "repaired_faces",
+          [](const Scene& s) {
+            py::list out;
+            for (const auto& k : s.repaired) out.append(py::make_tuple(k.face, k.what));
+            return out;
+          },
+          "(face, what was done) of the input faces solved after a repair: repeated corners "
+          "removed,\n"
+          "non-planar or self-crossing outlines split into triangles")
+      .def_property_readonly(
+          "coincident_faces",
+          [](const Scene& s) {
+            py::list out;
+            for (const auto& pair : s.coincident) out.append(py::make_tuple(pair[0], pair[1]));
+            return out;
+          },
+          "pairs of input faces that coincide somewhere (each surface counted once)")
+      .def_property_readonly(
+          "split_faces", [](const Scene& s) { return s.split_faces; },
+          "input faces split along what lies on or passes through them")
+      .def_property_readonly(
+          "patches",
+          [](const Scene& s) {
+            py::list out;
+            for (const Patch& p : s.patches) {
+              py::list corners;
+              for (int k = 0; k < p.corner_count; ++k) {
+                const dvec3& c = p.corners[static_cast<size_t>(k)];
+                corners.append(py::make_tuple(c.x, c.y, c.z));
+              }
+              py::list sides;
+              for (const PatchSide& side : p.sides)
+                sides.append(side.present ? py::object(py::make_tuple(side.face, side.face_side))
+                                          : py::object(py::none()));
+              out.append(py::dict(py::arg("corners") = corners, py::arg("area") = p.area,
+                                  py::arg("sides") = sides));
+            }
+            return out;
+          },
+          "the planar pieces solved: corners, area, and per side (front, back) the (face, face "
+          "side) it shows or None");
 
   py::class_<PyResult>(m, "Result", "The solved leaf mesh with per-vertex radiance.")
       .def_readonly("positions", &PyResult::positions, "(V, 3) float64 vertex positions")
-      .def_readonly("face_vertices", &PyResult::face_vertices, "polygons' vertex indices, concatenated")
+      .def_readonly("face_vertices", &PyResult::face_vertices,
+                    "polygons' vertex indices, concatenated")
       .def_readonly("face_sizes", &PyResult::face_sizes, "(P,) vertices per polygon")
       .def_readonly("radiance", &PyResult::radiance, "(V, 3) float32 radiance per vertex")
-      .def_readonly("vertex_irradiance", &PyResult::vertex_irradiance,
-                    "(V, 3) float32 gathered radiance H per vertex (irradiance / pi), before the surface's "
-                    "reflectance and emission: radiance = emission + reflectance * H")
+      .def_readonly(
+          "vertex_irradiance", &PyResult::vertex_irradiance,
+          "(V, 3) float32 gathered radiance H per vertex (irradiance / pi), before the surface's "
+          "reflectance and emission: radiance = emission + reflectance * H")
       .def_readonly("source_face", &PyResult::source_face, "(P,) input face of each polygon")
       .def_readonly("source_side", &PyResult::source_side, "(P,) 0 front, 1 back")
       .def_readonly("irradiance", &PyResult::irradiance,
@@ -422,24 +466,33 @@ void bind_solver(py::module_& m) {
 
   m.def("solve", &py_solve, py::arg("scene"), py::arg("oracle") = "perceptual",
         py::arg("quality") = 0.5, py::arg("max_elements") = py::none(),
-        py::arg("time_budget") = py::none(), py::arg("visibility") = "exact", py::arg("rays") = py::int_(16),
-        py::arg("bounces") = py::none(), py::arg("threads") = py::none(),
-        py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
-        py::arg("min_element_area") = 1e-5, py::arg("leaf_links") = "near",
-        py::arg("cluster_separation") = py::none(), py::arg("memory_limit") = py::none(),
+        py::arg("time_budget") = py::none(), py::arg("visibility") = "exact",
+        py::arg("rays") = py::int_(16), py::arg("bounces") = py::none(),
+        py::arg("threads") = py::none(), py::arg("progress") = py::none(),
+        py::arg("cancel") = py::none(), py::arg("min_element_area") = 1e-5,
+        py::arg("leaf_links") = "near", py::arg("cluster_separation") = py::none(),
+        py::arg("memory_limit") = py::none(),
         "Hierarchical radiosity. oracle: 'standard' | 'perceptual' | 'gradient'; quality in\n"
         "[0, 1] (0: no refinement); max_elements, time_budget (s): budgets; visibility:\n"
         "'exact' | 'sampled' (rays per sample); bounces: fixed iteration count instead of\n"
         "convergence; threads; progress(dict) callback; cancel: CancelToken;\n"
-        "leaf_links: 'near' | 'all' | 'none', which links follow a split end down ('all': energy to 1e-3);\n"
+        "leaf_links: 'near' | 'all' | 'none', which links follow a split end down ('all': energy "
+        "to 1e-3);\n"
         "cluster_separation: clusters of faces this many times their radii apart share one link\n"
-        "(default from quality, 2 to 10; inf: none); memory_limit: bytes the elements and links may hold\n"
-        "(default 3/4 of the available memory): refinement stops there (stats['stopped_by'] == 'memory'),\n"
+        "(default from quality, 2 to 10; inf: none); memory_limit: bytes the elements and links "
+        "may hold\n"
+        "(default 3/4 of the available memory): refinement stops there (stats['stopped_by'] == "
+        "'memory'),\n"
         "and a scene that cannot fit unrefined raises MemoryError before any work.");
-  m.def("quality_threshold", [](const std::string& oracle, double quality) {
-    if (!(quality >= 0.0 && quality <= 1.0)) throw std::invalid_argument("quality must lie in [0, 1]");
-    return quality_threshold(read_oracle(oracle), quality);
-  }, py::arg("oracle"), py::arg("quality"), "The oracle's refinement threshold at a quality level.");
+  m.def(
+      "quality_threshold",
+      [](const std::string& oracle, double quality) {
+        if (!(quality >= 0.0 && quality <= 1.0))
+          throw std::invalid_argument("quality must lie in [0, 1]");
+        return quality_threshold(read_oracle(oracle), quality);
+      },
+      py::arg("oracle"), py::arg("quality"),
+      "The oracle's refinement threshold at a quality level.");
 }
 
 }  // namespace radiosity::python

@@ -28,7 +28,8 @@ namespace {
 // The visible-polygon code needs a planar, convex emitter (the hierarchy's
 // triangles and quads are): say so here rather than return a wrong number.
 void require_planar_convex(const std::vector<dvec3>& polygon, const std::string& name) {
-  if (const char* problem = planar_convex_problem(polygon)) throw std::invalid_argument(name + " " + problem);
+  if (const char* problem = planar_convex_problem(polygon))
+    throw std::invalid_argument(name + " " + problem);
 }
 
 std::vector<Triangle> read_triangles(const py::handle& object, const std::string& name) {
@@ -59,7 +60,8 @@ std::vector<std::uint32_t> read_faces(const py::handle& object, std::size_t coun
   for (std::size_t t = 0; t < count; ++t) {
     const std::int64_t f = a.data()[t];
     if (f < 0 || f >= static_cast<std::int64_t>(kNoFace))
-      throw std::invalid_argument("faces[" + std::to_string(t) + "] = " + std::to_string(f) + " is not a face id");
+      throw std::invalid_argument("faces[" + std::to_string(t) + "] = " + std::to_string(f) +
+                                  " is not a face id");
     face[t] = static_cast<std::uint32_t>(f);
   }
   return face;
@@ -69,7 +71,8 @@ std::vector<std::uint32_t> read_faces(const py::handle& object, std::size_t coun
 std::array<std::uint32_t, 2> read_own_faces(const py::handle& object) {
   std::array<std::uint32_t, 2> own{kNoFace, kNoFace};
   const auto a = read_array_of<std::int64_t>(object, "own_faces", {-1});
-  if (a.size() > 2) throw std::invalid_argument("own_faces holds at most two faces (receiver's, emitter's)");
+  if (a.size() > 2)
+    throw std::invalid_argument("own_faces holds at most two faces (receiver's, emitter's)");
   for (py::ssize_t k = 0; k < a.size(); ++k) {
     if (a.data()[k] < 0 || a.data()[k] >= static_cast<std::int64_t>(kNoFace))
       throw std::invalid_argument("own_faces[" + std::to_string(k) + "] is not a face id");
@@ -82,7 +85,8 @@ py::array_t<double> to_numpy(const std::vector<dvec3>& points) {
   py::array_t<double> out({static_cast<py::ssize_t>(points.size()), py::ssize_t{3}});
   auto w = out.mutable_unchecked<2>();
   for (std::size_t i = 0; i < points.size(); ++i)
-    for (py::ssize_t k = 0; k < 3; ++k) w(static_cast<py::ssize_t>(i), k) = points[i][static_cast<int>(k)];
+    for (py::ssize_t k = 0; k < 3; ++k)
+      w(static_cast<py::ssize_t>(i), k) = points[i][static_cast<int>(k)];
   return out;
 }
 

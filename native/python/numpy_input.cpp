@@ -24,7 +24,10 @@ std::string expected_string(const std::vector<py::ssize_t>& shape) {
   out << "(";
   for (size_t i = 0; i < shape.size(); ++i) {
     out << (i ? ", " : "");
-    if (shape[i] < 0) out << (i == 0 ? "n" : "k"); else out << shape[i];
+    if (shape[i] < 0)
+      out << (i == 0 ? "n" : "k");
+    else
+      out << shape[i];
   }
   out << (shape.size() == 1 ? ",)" : ")");
   return out.str();
@@ -32,7 +35,8 @@ std::string expected_string(const std::vector<py::ssize_t>& shape) {
 
 }  // namespace
 
-void require_shape(const py::array& a, const std::string& name, const std::vector<py::ssize_t>& shape) {
+void require_shape(const py::array& a, const std::string& name,
+                   const std::vector<py::ssize_t>& shape) {
   bool ok = a.ndim() == static_cast<py::ssize_t>(shape.size());
   for (size_t i = 0; ok && i < shape.size(); ++i) {
     ok = shape[i] < 0 || a.shape(static_cast<py::ssize_t>(i)) == shape[i];
@@ -53,7 +57,8 @@ InputArray<double> read_array(const py::handle& object, const std::string& name,
 void require_finite(const double* data, size_t count, const std::string& name) {
   for (size_t i = 0; i < count; ++i) {
     if (!std::isfinite(data[i])) {
-      throw std::invalid_argument(name + " contains a non-finite value (NaN or infinity) at flat index " +
+      throw std::invalid_argument(name +
+                                  " contains a non-finite value (NaN or infinity) at flat index " +
                                   std::to_string(i));
     }
   }
@@ -68,8 +73,8 @@ void require_coordinates(const double* data, size_t count, const std::string& na
   for (size_t i = 0; i < count; ++i) {
     if (!(std::abs(data[i]) <= kMaxCoordinate)) {
       std::ostringstream message;
-      message << name << " has a coordinate of magnitude " << std::abs(data[i]) << " at flat index " << i
-              << ", beyond the " << kMaxCoordinate << " a scene may have";
+      message << name << " has a coordinate of magnitude " << std::abs(data[i]) << " at flat index "
+              << i << ", beyond the " << kMaxCoordinate << " a scene may have";
       throw std::invalid_argument(message.str());
     }
   }
@@ -107,7 +112,8 @@ std::vector<dvec3> read_polygon(const py::handle& object, const std::string& nam
   for (size_t i = 1; i + 1 < n; ++i) {
     area_normal += glm::cross(polygon[i] - polygon[0], polygon[i + 1] - polygon[0]);
   }
-  for (size_t i = 1; i < n; ++i) diameter = std::max(diameter, glm::length(polygon[i] - polygon[0]));
+  for (size_t i = 1; i < n; ++i)
+    diameter = std::max(diameter, glm::length(polygon[i] - polygon[0]));
   if (!(glm::length(area_normal) > 1e-12 * diameter * diameter) || !(diameter > 0.0)) {
     throw std::invalid_argument(name + " has zero area (collinear or coincident vertices)");
   }

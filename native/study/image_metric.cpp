@@ -58,20 +58,25 @@ GrayImage blur_pass(const GrayImage& in, const std::vector<double>& k, bool alon
   return out;
 }
 
-void write_floats(const std::string& path, int width, int height, int channels, const std::vector<float>& data) {
+void write_floats(const std::string& path, int width, int height, int channels,
+                  const std::vector<float>& data) {
   auto out = OIIO::ImageOutput::create(path);
   if (!out) throw std::invalid_argument("cannot write image '" + path + "': " + OIIO::geterror());
   // Float where the format holds it (EXR, TIFF, HDR), else 8 bits (PNG, JPEG).
   std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   const bool is_float = ext == ".exr" || ext == ".tif" || ext == ".tiff" || ext == ".hdr";
-  const OIIO::ImageSpec spec(width, height, channels, is_float ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
-  if (!out->open(path, spec)) throw std::invalid_argument("cannot write image '" + path + "': " + out->geterror());
+  const OIIO::ImageSpec spec(width, height, channels,
+                             is_float ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+  if (!out->open(path, spec))
+    throw std::invalid_argument("cannot write image '" + path + "': " + out->geterror());
   std::vector<float> clipped;
   const float* pixels = data.data();
   if (!is_float) {
     clipped.resize(data.size());
-    std::transform(data.begin(), data.end(), clipped.begin(), [](float v) { return std::clamp(v, 0.0f, 1.0f); });
+    std::transform(data.begin(), data.end(), clipped.begin(),
+                   [](float v) { return std::clamp(v, 0.0f, 1.0f); });
     pixels = clipped.data();
   }
   const bool ok = out->write_image(OIIO::TypeDesc::FLOAT, pixels);
@@ -95,7 +100,8 @@ RgbImage read_rgb_image(const std::string& path) {
   if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, all.data())) {
     throw std::invalid_argument("cannot read image '" + path + "': " + in->geterror());
   }
-  RgbImage img{spec.width, spec.height, std::vector<float>(static_cast<size_t>(spec.width) * spec.height * 3)};
+  RgbImage img{spec.width, spec.height,
+               std::vector<float>(static_cast<size_t>(spec.width) * spec.height * 3)};
   for (size_t p = 0; p < static_cast<size_t>(spec.width) * spec.height; ++p) {
     for (int c = 0; c < 3; ++c) {
       img.rgb[3 * p + c] = all[p * channels + (channels >= 3 ? c : 0)];
@@ -106,7 +112,8 @@ RgbImage read_rgb_image(const std::string& path) {
 
 void write_gray_image(const std::string& path, const GrayImage& image) {
   require_size(image.width, image.height, "write_gray_image");
-  write_floats(path, image.width, image.height, 1, std::vector<float>(image.values.begin(), image.values.end()));
+  write_floats(path, image.width, image.height, 1,
+               std::vector<float>(image.values.begin(), image.values.end()));
 }
 
 void write_rgb_image(const std::string& path, const RgbImage& image) {
@@ -118,7 +125,8 @@ GrayImage brightness(const RgbImage& image, BrightnessEncoding encoding) {
   GrayImage out{image.width, image.height, std::vector<double>(image.rgb.size() / 3)};
   for (size_t p = 0; p < out.values.size(); ++p) {
     const double y = luminance(Rgb(image.rgb[3 * p], image.rgb[3 * p + 1], image.rgb[3 * p + 2]));
-    out.values[p] = encoding == BrightnessEncoding::Linear ? y : srgb_encode(std::clamp(y, 0.0, 1.0));
+    out.values[p] =
+        encoding == BrightnessEncoding::Linear ? y : srgb_encode(std::clamp(y, 0.0, 1.0));
   }
   return out;
 }
@@ -132,9 +140,11 @@ GrayImage gaussian_blur(const GrayImage& image, double sigma) {
   return blur_pass(blur_pass(image, k, true), k, false);
 }
 
-GrayImage difference_of_gaussians(const GrayImage& image, double sigma_center, double sigma_surround) {
+GrayImage difference_of_gaussians(const GrayImage& image, double sigma_center,
+                                  double sigma_surround) {
   if (!(sigma_surround > sigma_center)) {
-    throw std::invalid_argument("sigma_surround must exceed sigma_center (" + std::to_string(sigma_surround) +
+    throw std::invalid_argument("sigma_surround must exceed sigma_center (" +
+                                std::to_string(sigma_surround) +
                                 " <= " + std::to_string(sigma_center) + ")");
   }
   GrayImage out = gaussian_blur(image, sigma_center);
@@ -157,8 +167,8 @@ EdgeFilterSigmas default_edge_sigmas(int width) {
 double rms_difference(const GrayImage& a, const GrayImage& b) {
   if (a.width != b.width || a.height != b.height) {
     throw std::invalid_argument("images differ in size: " + std::to_string(a.width) + " x " +
-                                std::to_string(a.height) + " and " + std::to_string(b.width) + " x " +
-                                std::to_string(b.height));
+                                std::to_string(a.height) + " and " + std::to_string(b.width) +
+                                " x " + std::to_string(b.height));
   }
   require_size(a.width, a.height, "rms_difference");
   double sum = 0.0;

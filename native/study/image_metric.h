@@ -51,7 +51,8 @@ GrayImage gaussian_blur(const GrayImage& image, double sigma);
 
 // Centre-surround filter: blur(sigma_center) - blur(sigma_surround), with
 // sigma_surround > sigma_center > 0 (pixels).
-GrayImage difference_of_gaussians(const GrayImage& image, double sigma_center, double sigma_surround);
+GrayImage difference_of_gaussians(const GrayImage& image, double sigma_center,
+                                  double sigma_surround);
 
 // The default sigmas for an image `width` pixels wide, relative to the width so
 // that a smaller snapshot of the same view gives a comparable number.

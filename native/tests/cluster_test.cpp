@@ -21,9 +21,11 @@ struct Arrays {
   std::vector<std::uint8_t> two_sided;
 
   // An axis-aligned square of side `a` at `origin`, facing +z or -z.
-  void square(const dvec3& origin, double a, bool up, double rho, double emit, bool both_sides = false) {
+  void square(const dvec3& origin, double a, bool up, double rho, double emit,
+              bool both_sides = false) {
     const auto base = static_cast<std::int64_t>(positions.size() / 3);
-    const dvec3 c[4] = {origin, origin + dvec3(a, 0, 0), origin + dvec3(a, a, 0), origin + dvec3(0, a, 0)};
+    const dvec3 c[4] = {origin, origin + dvec3(a, 0, 0), origin + dvec3(a, a, 0),
+                        origin + dvec3(0, a, 0)};
     for (int k = 0; k < 4; ++k) {
       const dvec3& p = c[up ? k : 3 - k];
       positions.insert(positions.end(), {p.x, p.y, p.z});
@@ -34,19 +36,25 @@ struct Arrays {
     emission.insert(emission.end(), {emit, emit, emit});
     two_sided.push_back(both_sides ? 1 : 0);
   }
-  Scene scene() const { return make_scene({positions, faces, sizes, reflectance, emission, two_sided, {}, {}, {}}); }
+  Scene scene() const {
+    return make_scene({positions, faces, sizes, reflectance, emission, two_sided, {}, {}, {}});
+  }
 };
 
 // A grid of n x n small squares at height z, facing up or down.
 void grid(Arrays& a, double z, int n, bool up, double rho, double emit, bool both_sides = false) {
   for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) a.square(dvec3(0.3 * i, 0.3 * j, z), 0.2, up, rho, emit, both_sides);
+    for (int j = 0; j < n; ++j)
+      a.square(dvec3(0.3 * i, 0.3 * j, z), 0.2, up, rho, emit, both_sides);
 }
 
 // A scene with its hierarchy, cluster tree and occluders, linked at `separation`.
 struct Linked {
-  explicit Linked(const Arrays& a) : scene(a.scene()), h(scene), tree(h), occluders(make_scene_occluders(scene)) {}
-  InitialLinks link(double separation) const { return link_clusters(tree, h, *occluders.rays, separation, 16, {}); }
+  explicit Linked(const Arrays& a)
+      : scene(a.scene()), h(scene), tree(h), occluders(make_scene_occluders(scene)) {}
+  InitialLinks link(double separation) const {
+    return link_clusters(tree, h, *occluders.rays, separation, 16, {});
+  }
   Scene scene;
   Hierarchy h;
   ClusterTree tree;
@@ -71,14 +79,16 @@ TEST(ClusterTree, EverySideInOneLeafAndNodesHoldTheirSides) {
     for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
       dvec3 c[4];
       const int n = h.corners(h.element(tree.sides()[i]), c);
-      for (int k = 0; k < n; ++k) EXPECT_LE(glm::length(c[k] - node.centre), node.radius * (1 + 1e-12));
+      for (int k = 0; k < n; ++k)
+        EXPECT_LE(glm::length(c[k] - node.centre), node.radius * (1 + 1e-12));
     }
     const ClusterNode& l = tree.node(node.child[0]);
     const ClusterNode& r = tree.node(node.child[1]);
     EXPECT_EQ(l.first, node.first);
     EXPECT_EQ(l.count + r.count, node.count);
     for (const ClusterNode* c : {&l, &r}) {
-      EXPECT_LE(std::acos(std::clamp(glm::dot(c->axis, node.axis), -1.0, 1.0)) + c->spread, node.spread + 1e-9);
+      EXPECT_LE(std::acos(std::clamp(glm::dot(c->axis, node.axis), -1.0, 1.0)) + c->spread,
+                node.spread + 1e-9);
     }
   }
   // 25 two-sided squares (50 sides) and 16 one-sided lights.
@@ -121,7 +131,8 @@ TEST(ClusterLinks, FarLightMatchesThePointFormFactorsOfItsSides) {
   Arrays a;
   grid(a, 0.0, 4, true, 0.5, 0.0);
   grid(a, 20.0, 4, false, 0.5, 0.0);
-  a.square(dvec3(0.0, 0.0, -50.0), 0.1, false, 0.0, 1.0);  // a scene needs an emitter: this one faces away
+  a.square(dvec3(0.0, 0.0, -50.0), 0.1, false, 0.0,
+           1.0);  // a scene needs an emitter: this one faces away
   const Linked linked(a);
   const Hierarchy& h = linked.h;
   const ClusterTree& tree = linked.tree;
@@ -145,9 +156,11 @@ TEST(ClusterLinks, FarLightMatchesThePointFormFactorsOfItsSides) {
       if (face_linked(h.root(static_cast<std::uint32_t>(r), 0), h.root(q, 0))) continue;
       dvec3 c[4];
       const int n = h.corners(h.element(h.root(q, 0)), c);
-      exact += 2.0 * form_factor(h.centre(receiver), h.normal(receiver), std::span<const dvec3>(c, static_cast<size_t>(n)));
+      exact += 2.0 * form_factor(h.centre(receiver), h.normal(receiver),
+                                 std::span<const dvec3>(c, static_cast<size_t>(n)));
     }
-    EXPECT_NEAR(gathered[static_cast<size_t>(h.root(static_cast<std::uint32_t>(r), 0))].x, exact, 0.01 * exact);
+    EXPECT_NEAR(gathered[static_cast<size_t>(h.root(static_cast<std::uint32_t>(r), 0))].x, exact,
+                0.01 * exact);
   }
 }
 
@@ -172,9 +185,10 @@ TEST(ClusterLinks, SidesHiddenFromTheLightsGetNoLinksFromThem) {
   Arrays a;
   grid(a, 0.0, 4, true, 0.5, 0.0);
   const dvec3 lo(0.0, 0.0, 10.0);
-  a.square(lo, 1.0, false, 0.5, 0.0, true);                 // bottom, two-sided
+  a.square(lo, 1.0, false, 0.5, 0.0, true);                     // bottom, two-sided
   a.square(lo + dvec3(0.25, 0.25, 0.5), 0.5, false, 0.5, 0.0);  // hidden, facing down
-  a.square(dvec3(0.0, 0.0, -50.0), 0.1, false, 0.0, 1.0);       // a scene needs an emitter: this one faces away
+  a.square(dvec3(0.0, 0.0, -50.0), 0.1, false, 0.0,
+           1.0);  // a scene needs an emitter: this one faces away
   const Linked linked(a);
   const Hierarchy& h = linked.h;
   const ClusterTree& tree = linked.tree;

@@ -1,9 +1,10 @@
 // The emitter-side shape of a link: a coarse emitter whose radiance varies
 // sends, along a link, its radiance weighted by how well each part of it sees
 // the receiver (emitter_shape.h).
+#include "core/emitter_shape.h"
+
 #include <gtest/gtest.h>
 
-#include "core/emitter_shape.h"
 #include "core/form_factor.h"
 #include "core/scene.h"
 
@@ -13,8 +14,9 @@ namespace {
 // A unit floor (facing +z) and a small wall standing near its x = 1 edge,
 // facing back over the floor (-x).
 Scene floor_and_wall(double gap) {
-  const std::vector<double> positions = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0,
-                                         1 + gap, 0.4, 0.05, 1 + gap, 0.4, 0.25, 1 + gap, 0.6, 0.25, 1 + gap, 0.6, 0.05};
+  const std::vector<double> positions = {0,   0,    0,       1,   0,       0,       1,    1,
+                                         0,   0,    1,       0,   1 + gap, 0.4,     0.05, 1 + gap,
+                                         0.4, 0.25, 1 + gap, 0.6, 0.25,    1 + gap, 0.6,  0.05};
   const std::vector<std::int64_t> faces = {0, 1, 2, 3, 4, 5, 6, 7};
   const std::vector<std::int64_t> sizes = {4, 4};
   const std::vector<double> reflectance = {0.5, 0.5, 0.5, 0.5, 0.5, 0.5};

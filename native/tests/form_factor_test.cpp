@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
-
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "tests/test_geometry.h"
@@ -72,8 +71,8 @@ std::vector<dvec3> perpendicular_rectangle_x(double a, double b, double c) {
 }
 
 TEST(FormFactor, PerpendicularMatchesClosedForm) {
-  for (auto [a, b, c, reference] : {std::array{1.0, 1.0, 1.0, 0.055734197002553512},
-                                    {2.0, 1.0, 0.5, 0.15877480451429929}}) {
+  for (auto [a, b, c, reference] :
+       {std::array{1.0, 1.0, 1.0, 0.055734197002553512}, {2.0, 1.0, 0.5, 0.15877480451429929}}) {
     const auto quad = perpendicular_rectangle(a, b, c);
     expect_relative(form_factor(dvec3(0), kUp, quad), perpendicular(a, b, c), 1e-12);
     expect_relative(form_factor(dvec3(0), kUp, quad), reference, 1e-12);
@@ -88,26 +87,26 @@ TEST(FormFactor, EmitterStraddlingTheHorizonKeepsTheUpperPart) {
   expect_relative(form_factor(dvec3(0), kUp, wall), perpendicular(a, b, c), 1e-12);
   const auto [value, gradient] = form_factor_gradient(dvec3(0), kUp, wall);
   expect_relative(value, perpendicular(a, b, c), 1e-12);
-  const dvec3 fd = central_difference([&](const dvec3& r) { return form_factor(r, kUp, wall); },
-                                      dvec3(0), 1e-6);
+  const dvec3 fd =
+      central_difference([&](const dvec3& r) { return form_factor(r, kUp, wall); }, dvec3(0), 1e-6);
   expect_vec_near(gradient, fd, 1e-7);
 }
 
 // Inside a 2 x 1 x 1.5 box every wall faces inwards; from any interior point the
 // six form factors sum to 1.
 std::array<std::vector<dvec3>, 6> box_walls(double w, double d, double h) {
-  return {{{{0, 0, 0}, {w, 0, 0}, {w, d, 0}, {0, d, 0}},   // z = 0 facing +z
-           {{0, 0, h}, {0, d, h}, {w, d, h}, {w, 0, h}},   // z = h facing -z
-           {{0, 0, 0}, {0, 0, h}, {w, 0, h}, {w, 0, 0}},   // y = 0 facing +y
-           {{0, d, 0}, {w, d, 0}, {w, d, h}, {0, d, h}},   // y = d facing -y
-           {{0, 0, 0}, {0, d, 0}, {0, d, h}, {0, 0, h}},   // x = 0 facing +x
-           {{w, 0, 0}, {w, 0, h}, {w, d, h}, {w, d, 0}}}}; // x = w facing -x
+  return {{{{0, 0, 0}, {w, 0, 0}, {w, d, 0}, {0, d, 0}},    // z = 0 facing +z
+           {{0, 0, h}, {0, d, h}, {w, d, h}, {w, 0, h}},    // z = h facing -z
+           {{0, 0, 0}, {0, 0, h}, {w, 0, h}, {w, 0, 0}},    // y = 0 facing +y
+           {{0, d, 0}, {w, d, 0}, {w, d, h}, {0, d, h}},    // y = d facing -y
+           {{0, 0, 0}, {0, d, 0}, {0, d, h}, {0, 0, h}},    // x = 0 facing +x
+           {{w, 0, 0}, {w, 0, h}, {w, d, h}, {w, d, 0}}}};  // x = w facing -x
 }
 
 TEST(FormFactor, BoxWallsMatchReferenceAndSumToOne) {
   const auto walls = box_walls(2, 1, 1.5);
-  const double reference[6] = {0, 0.19708576974, 0.364081708387, 0.224651995337, 0.150446513775,
-                               0.063734012761};
+  const double reference[6] = {
+      0, 0.19708576974, 0.364081708387, 0.224651995337, 0.150446513775, 0.063734012761};
   double sum = 0;
   for (int i = 0; i < 6; ++i) {
     const double f = form_factor({0.7, 0.3, 0}, kUp, walls[i]);
@@ -145,11 +144,14 @@ TEST(FormFactorGradient, MatchesReferenceValues) {
   const Case cases[] = {
       {rectangle_facing_down(-.5, .5, -.5, .5, 1), 0.23945647046077351, {0, 0, 0.361330448999974}},
       {rectangle_facing_down(-1, 1, -.5, .5, .5), 0.66950003965753502, {0, 0, 0.822915384485942}},
-      {rectangle_facing_down(0, 1, 0, 1, 1), 0.13853160599489298,
+      {rectangle_facing_down(0, 1, 0, 1, 1),
+       0.13853160599489298,
        {0.143418746198575, 0.143418746198575, 0.122317450694745}},
-      {perpendicular_rectangle_x(1, 1, 1), 0.055734197002553512,
+      {perpendicular_rectangle_x(1, 1, 1),
+       0.055734197002553512,
        {0.087684549196022, 0.053051647697298, -0.061158725347372}},
-      {perpendicular_rectangle_x(2, 1, .5), 0.15877480451429929,
+      {perpendicular_rectangle_x(2, 1, .5),
+       0.15877480451429929,
        {0.158356492466451, 0.251081411622844, -0.015336941312133}},
   };
   for (const Case& c : cases) {
@@ -191,16 +193,17 @@ TEST(FormFactorGradient, MatchesFiniteDifferencesOnRandomConfigurations) {
       ++robust_stats.skipped;
       continue;
     }
-    for (auto [stats, gradient] : {std::pair{&robust_stats, robust.gradient},
-                                   std::pair{&general_stats, general.gradient}}) {
+    for (auto [stats, gradient] :
+         {std::pair{&robust_stats, robust.gradient}, std::pair{&general_stats, general.gradient}}) {
       const double error = glm::length(gradient - fd) / magnitude;
       stats->worst = std::max(stats->worst, error);
       ++stats->checked;
       EXPECT_LT(error, 1e-6) << "trial " << trial;
     }
   }
-  std::printf("gradient vs FD: %d checked, %d skipped; worst relative error robust %.3g, general %.3g\n",
-              robust_stats.checked, robust_stats.skipped, robust_stats.worst, general_stats.worst);
+  std::printf(
+      "gradient vs FD: %d checked, %d skipped; worst relative error robust %.3g, general %.3g\n",
+      robust_stats.checked, robust_stats.skipped, robust_stats.worst, general_stats.worst);
   EXPECT_GE(robust_stats.checked, 10000);
 }
 
@@ -220,7 +223,8 @@ double integrate_triangle(const dvec3& r, const dvec3& n, const dvec3& ne, const
                           const dvec3& b, const dvec3& c, double tolerance, int depth) {
   const auto rule = [&](const dvec3& p, const dvec3& q, const dvec3& s) {
     const double area = 0.5 * glm::length(glm::cross(q - p, s - p));
-    const double w0 = 9.0 / 40, w1 = (155 - std::sqrt(15.0)) / 1200, w2 = (155 + std::sqrt(15.0)) / 1200;
+    const double w0 = 9.0 / 40, w1 = (155 - std::sqrt(15.0)) / 1200,
+                 w2 = (155 + std::sqrt(15.0)) / 1200;
     const double a1 = (6 - std::sqrt(15.0)) / 21, a2 = (6 + std::sqrt(15.0)) / 21;
     const auto at = [&](double l1, double l2) {
       return kernel(r, n, p * (1 - l1 - l2) + q * l1 + s * l2, ne);
@@ -259,8 +263,8 @@ std::vector<std::array<dvec3, 3>> split_at_horizon(const dvec3& r, const dvec3& 
 double brute_force_form_factor(const test::RandomConfiguration& c) {
   double sum = 0;
   for (size_t i = 1; i + 1 < c.polygon.size(); ++i) {
-    for (const auto& t : split_at_horizon(c.point, c.normal,
-                                          {c.polygon[0], c.polygon[i], c.polygon[i + 1]})) {
+    for (const auto& t :
+         split_at_horizon(c.point, c.normal, {c.polygon[0], c.polygon[i], c.polygon[i + 1]})) {
       sum += integrate_triangle(c.point, c.normal, c.emitter_normal, t[0], t[1], t[2], 1e-11, -1);
     }
   }
@@ -351,7 +355,8 @@ TEST(FormFactorExtremes, ScaleFrom1e100To1e100) {
   const double f_unit = form_factor(r * 0x1p268, n, unit);
   EXPECT_NEAR(f, f_unit, 1e-12);
   dvec3 area(0.0);
-  for (size_t i = 1; i + 1 < unit.size(); ++i) area += glm::cross(unit[i] - unit[0], unit[i + 1] - unit[0]);
+  for (size_t i = 1; i + 1 < unit.size(); ++i)
+    area += glm::cross(unit[i] - unit[0], unit[i + 1] - unit[0]);
   EXPECT_NEAR(f_unit, 0.5 * (1.0 - glm::dot(n, glm::normalize(area))), 1e-6);
 }
 
@@ -363,7 +368,8 @@ TEST(FormFactorExtremes, ReceiverOnAVertexOfASliverSeesNothing) {
                                      {2.8625488677062094, 2.862745098039216, 2.862745098039216},
                                      {2.862745098039216, 2.862745098039216, 2.862745098039216}};
   const dvec3 n = glm::normalize(dvec3(-9.999999999999954, -7.490196078431373, -10.0));
-  for (const dvec3& r : {sliver[2], dvec3(2.862745098039219, 2.8627450980392064, 2.862745098039214)}) {
+  for (const dvec3& r :
+       {sliver[2], dvec3(2.862745098039219, 2.8627450980392064, 2.862745098039214)}) {
     EXPECT_EQ(form_factor(r, n, sliver), 0.0);
     EXPECT_EQ(form_factor_gradient(r, n, sliver).value, 0.0);
     EXPECT_EQ(form_factor_gradient(r, n, as_contour(sliver)).value, 0.0);
@@ -385,10 +391,11 @@ TEST(FormFactorExtremes, ReceiverWithinATwistedCornerSeesNothing) {
   // Planar to 1e-9 of its size (4), but its corner at the origin, 6e-9
   // across, drops 3e-9: a receiver 3e-10 above that corner is within the
   // polygon's thickness, on it (F was -6.5e-4; libFuzzer kernels, crash-dd8d717d).
-  const std::vector<dvec3> p = {{-4.7165402388330148e-10, 2.9334841597860532e-310, 0.0},
-                                {0.0, -4.0, -3.2099434464697876e-09},
-                                {-3.2096664895593493e-09, 4.3486241962839191e-09, -2.1119385739660850e-09},
-                                {-4.0078836909046392e-09, -3.8029735139882818e-09, 1.1701537641651122e-09}};
+  const std::vector<dvec3> p = {
+      {-4.7165402388330148e-10, 2.9334841597860532e-310, 0.0},
+      {0.0, -4.0, -3.2099434464697876e-09},
+      {-3.2096664895593493e-09, 4.3486241962839191e-09, -2.1119385739660850e-09},
+      {-4.0078836909046392e-09, -3.8029735139882818e-09, 1.1701537641651122e-09}};
   EXPECT_EQ(form_factor(dvec3(0.0), kUp, p), 0.0);
   EXPECT_EQ(form_factor_gradient(dvec3(0.0), kUp, p).value, 0.0);
 }
@@ -419,7 +426,8 @@ TEST(FormFactorExtremes, TinySquareSubtending1e8Radians) {
 
 TEST(FormFactorExtremes, ReceiverOnTheEmitterPlaneGivesZero) {
   const auto quad = rectangle_facing_down(-1, 1, -1, 1, 0);
-  for (dvec3 r : {dvec3(0, 0, 0), dvec3(1, 0, 0), dvec3(1, 1, 0), dvec3(3, 0, 0), dvec3(0.5, 0.5, 1e-12)}) {
+  for (dvec3 r :
+       {dvec3(0, 0, 0), dvec3(1, 0, 0), dvec3(1, 1, 0), dvec3(3, 0, 0), dvec3(0.5, 0.5, 1e-12)}) {
     for (dvec3 n : {dvec3(0, 0, 1), dvec3(0, 0, -1), glm::normalize(dvec3(1, 0, -1))}) {
       EXPECT_EQ(form_factor(r, n, quad), 0.0);
       const auto robust = form_factor_gradient(r, n, quad);
@@ -460,8 +468,8 @@ TEST(FormFactorExtremes, EdgeSubtendingExactly90Degrees) {
   ASSERT_EQ(glm::dot(triangle[0], triangle[1]), 0.0);
   const auto robust = form_factor_gradient(dvec3(0), kUp, triangle);
   const auto general = form_factor_gradient(dvec3(0), kUp, as_contour(triangle));
-  const dvec3 fd = central_difference(
-      [&](const dvec3& r) { return form_factor(r, kUp, triangle); }, dvec3(0), 1e-6);
+  const dvec3 fd = central_difference([&](const dvec3& r) { return form_factor(r, kUp, triangle); },
+                                      dvec3(0), 1e-6);
   expect_vec_near(robust.gradient, fd, 1e-8);
   expect_vec_near(general.gradient, fd, 1e-8);
 }
@@ -486,7 +494,8 @@ TEST(FormFactorInvariance, TranslationRotationAndScale) {
     EXPECT_NEAR(result.value, base.value, 1e-10 + 1e-9 * base.value);
     // The gradient rotates with the scene and scales by 1/s.
     const dvec3 expected = rotation * base.gradient / scale;
-    EXPECT_LE(glm::length(result.gradient - expected), 1e-8 * glm::length(expected) + 1e-10 / scale);
+    EXPECT_LE(glm::length(result.gradient - expected),
+              1e-8 * glm::length(expected) + 1e-10 / scale);
   }
 }
 
@@ -540,7 +549,8 @@ TEST(FormFactorGradient, ApparentVerticesMatchFiniteDifferences) {
     const Line edge{{0.3 * u(rng), 0.3 * u(rng), 1}, {std::cos(angle), std::sin(angle), 0}};
     const dvec3 r{0.4 * u(rng), 0.4 * u(rng), 0.5 * u(rng)};
     dvec3 n;
-    do n = test::random_unit(rng); while (n.z < 0.2);
+    do n = test::random_unit(rng);
+    while (n.z < 0.2);
     const auto contour = visible_part(r, edge);
     if (contour.size() < 3) continue;
     bool has_apparent = false;

@@ -35,8 +35,15 @@ struct Profile {
 // A penumbra from 0.1 to 1 as a smoothstep over [x0, x0 + w].
 Profile penumbra(double x0, double w) {
   const auto t = [=](double x) { return std::clamp((x - x0) / w, 0.0, 1.0); };
-  return Profile([=](double x) { const double s = t(x); return 0.1 + 0.9 * s * s * (3 - 2 * s); },
-                 [=](double x) { const double s = t(x); return (s > 0 && s < 1) ? 0.9 * 6 * s * (1 - s) / w : 0.0; });
+  return Profile(
+      [=](double x) {
+        const double s = t(x);
+        return 0.1 + 0.9 * s * s * (3 - 2 * s);
+      },
+      [=](double x) {
+        const double s = t(x);
+        return (s > 0 && s < 1) ? 0.9 * 6 * s * (1 - s) / w : 0.0;
+      });
 }
 
 TEST(PerceptualOracle, CaseA_UniformRegionIsNotRefined) {
@@ -122,11 +129,14 @@ TEST(Oracle, ScaleMakesThresholdsRelative) {
   // relative value unchanged: check the scale's units.
   const double area = 80, radiance = 0.06;
   EXPECT_NEAR(oracle_scale(Oracle::Standard, 2 * radiance, 4 * area) /
-                  oracle_scale(Oracle::Standard, radiance, area), 8.0, 1e-12);
+                  oracle_scale(Oracle::Standard, radiance, area),
+              8.0, 1e-12);
   EXPECT_NEAR(oracle_scale(Oracle::Perceptual, 2 * radiance, 4 * area) /
-                  oracle_scale(Oracle::Perceptual, radiance, area), 2.0, 1e-12);
+                  oracle_scale(Oracle::Perceptual, radiance, area),
+              2.0, 1e-12);
   EXPECT_NEAR(oracle_scale(Oracle::Gradient, 2 * radiance, 4 * area) /
-                  oracle_scale(Oracle::Gradient, radiance, area), 4.0, 1e-12);
+                  oracle_scale(Oracle::Gradient, radiance, area),
+              4.0, 1e-12);
 }
 
 }  // namespace

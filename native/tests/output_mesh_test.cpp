@@ -1,12 +1,12 @@
 // The boundary's guarantee: an output mesh with any non-finite value is an
 // error naming the input face, never a result.
+#include "core/output_mesh.h"
+
 #include <gtest/gtest.h>
 
 #include <limits>
 #include <stdexcept>
 #include <string>
-
-#include "core/output_mesh.h"
 
 namespace radiosity {
 namespace {
@@ -40,17 +40,20 @@ TEST(RequireFinite, NamesTheFaceOfEachKindOfValue) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   OutputMesh radiance = two_triangles();
   radiance.radiance[3 * 3 + 1] = nan;  // vertex 3: only in the second triangle
-  EXPECT_NE(error_of(radiance).find("non-finite radiance on input face 9 (back side"), std::string::npos)
+  EXPECT_NE(error_of(radiance).find("non-finite radiance on input face 9 (back side"),
+            std::string::npos)
       << error_of(radiance);
   OutputMesh position = two_triangles();
   position.positions[1 * 3] = std::numeric_limits<double>::infinity();  // vertex 1: first triangle
-  EXPECT_NE(error_of(position).find("non-finite position on input face 7 (front side"), std::string::npos);
+  EXPECT_NE(error_of(position).find("non-finite position on input face 7 (front side"),
+            std::string::npos);
   OutputMesh irradiance = two_triangles();
   irradiance.irradiance[5] = -std::numeric_limits<float>::infinity();
   EXPECT_NE(error_of(irradiance).find("non-finite irradiance on input face 9"), std::string::npos);
   OutputMesh gathered = two_triangles();
   gathered.vertex_irradiance[0] = nan;
-  EXPECT_NE(error_of(gathered).find("non-finite vertex irradiance on input face 7"), std::string::npos);
+  EXPECT_NE(error_of(gathered).find("non-finite vertex irradiance on input face 7"),
+            std::string::npos);
 }
 
 }  // namespace

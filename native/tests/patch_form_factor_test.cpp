@@ -8,11 +8,10 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <random>
 #include <vector>
-
-#include <glm/gtc/matrix_transform.hpp>
 
 #include "core/form_factor.h"
 #include "tests/test_geometry.h"
@@ -35,7 +34,9 @@ double relative_error(double actual, double expected) {
 }
 
 // Quad c, c + u, c + u + v, c + v: counter-clockwise about u x v.
-Polygon quad(const dvec3& c, const dvec3& u, const dvec3& v) { return {c, c + u, c + u + v, c + v}; }
+Polygon quad(const dvec3& c, const dvec3& u, const dvec3& v) {
+  return {c, c + u, c + u + v, c + v};
+}
 
 // --- Closed forms (Howell's catalogue), in long double so that the reference's
 // own cancellation at large distances stays below the tolerance. ---------------
@@ -54,12 +55,11 @@ double parallel_rectangles(long double a, long double b, long double c) {
 // their common edge of length l.
 double perpendicular_rectangles(long double w, long double h, long double l) {
   const long double W = w / l, H = h / l, W2 = W * W, H2 = H * H, R = std::sqrt(W2 + H2);
-  const long double log_term =
-      std::log((1 + W2) * (1 + H2) / (1 + W2 + H2)) +
-      W2 * std::log(W2 * (1 + W2 + H2) / ((1 + W2) * (W2 + H2))) +
-      H2 * std::log(H2 * (1 + H2 + W2) / ((1 + H2) * (H2 + W2)));
-  const long double f = W * std::atan(1 / W) + H * std::atan(1 / H) - R * std::atan(1 / R) +
-                        0.25L * log_term;
+  const long double log_term = std::log((1 + W2) * (1 + H2) / (1 + W2 + H2)) +
+                               W2 * std::log(W2 * (1 + W2 + H2) / ((1 + W2) * (W2 + H2))) +
+                               H2 * std::log(H2 * (1 + H2 + W2) / ((1 + H2) * (H2 + W2)));
+  const long double f =
+      W * std::atan(1 / W) + H * std::atan(1 / H) - R * std::atan(1 / R) + 0.25L * log_term;
   return static_cast<double>(f / (3.14159265358979323846264338L * W));
 }
 
@@ -69,8 +69,13 @@ Polygon floor_rectangle(double x0, double x1, double y0, double y1) {
 
 TEST(PatchFormFactor, ParallelOpposedRectanglesMatchC11) {
   double worst = 0.0;
-  for (auto [a, b, c] : {std::array{1.0, 1.0, 1.0}, {1.0, 1.0, 0.1}, {2.0, 0.5, 0.7},
-                         {0.2, 3.0, 1.5}, {1.0, 1.0, 3.0}, {1.0, 2.0, 10.0}, {1.0, 1.0, 100.0}}) {
+  for (auto [a, b, c] : {std::array{1.0, 1.0, 1.0},
+                         {1.0, 1.0, 0.1},
+                         {2.0, 0.5, 0.7},
+                         {0.2, 3.0, 1.5},
+                         {1.0, 1.0, 3.0},
+                         {1.0, 2.0, 10.0},
+                         {1.0, 1.0, 100.0}}) {
     const Polygon p = floor_rectangle(-a / 2, a / 2, -b / 2, b / 2);
     const Polygon q = test::rectangle_facing_down(-a / 2, a / 2, -b / 2, b / 2, c);
     const double error = relative_error(patch_form_factor(p, q), parallel_rectangles(a, b, c));
@@ -83,8 +88,12 @@ TEST(PatchFormFactor, ParallelOpposedRectanglesMatchC11) {
 
 TEST(PatchFormFactor, PerpendicularSharedEdgeMatchesC14) {
   double worst = 0.0;
-  for (auto [w, h, l] : {std::array{1.0, 1.0, 1.0}, {2.0, 1.0, 1.0}, {1.0, 3.0, 0.5},
-                         {0.1, 1.0, 2.0}, {5.0, 0.2, 1.0}, {1.0, 1.0, 20.0}}) {
+  for (auto [w, h, l] : {std::array{1.0, 1.0, 1.0},
+                         {2.0, 1.0, 1.0},
+                         {1.0, 3.0, 0.5},
+                         {0.1, 1.0, 2.0},
+                         {5.0, 0.2, 1.0},
+                         {1.0, 1.0, 20.0}}) {
     const Polygon p = floor_rectangle(0, w, 0, l);
     const Polygon q = quad({0, 0, 0}, {0, l, 0}, {0, 0, h});  // wall x = 0 facing +x
     const double expected = perpendicular_rectangles(w, h, l);
@@ -131,8 +140,7 @@ Polygon hinged(std::mt19937_64& rng, const Polygon& p, size_t edge, double angle
   const dvec3 to = exact ? a : a + (0.3 - 0.6 * uniform(rng)) * (b - a);
   const double height = 0.3 + 1.5 * uniform(rng);
   if (uniform(rng) < 0.5) return {from, to, 0.5 * (from + to) + height * out};
-  return {from, to, to + height * out + 0.2 * (uniform(rng) - 0.5) * (b - a),
-          from + height * out};
+  return {from, to, to + height * out + 0.2 * (uniform(rng) - 0.5) * (b - a), from + height * out};
 }
 
 struct Pair {
@@ -149,7 +157,8 @@ std::vector<Pair> random_pairs(uint64_t seed, int count) {
     pair.p = random_convex(rng, dvec3(0.0), test::random_unit(rng), 0.3 + uniform(rng));
     if (uniform(rng) < 0.3) {
       const size_t edge = static_cast<size_t>(uniform(rng) * static_cast<double>(pair.p.size()));
-      pair.q = hinged(rng, pair.p, std::min(edge, pair.p.size() - 1), 0.05 + (kPi - 0.1) * uniform(rng));
+      pair.q =
+          hinged(rng, pair.p, std::min(edge, pair.p.size() - 1), 0.05 + (kPi - 0.1) * uniform(rng));
     } else {
       const dvec3 centre = (0.2 + 2.0 * uniform(rng)) * test::random_unit(rng);
       pair.q = random_convex(rng, centre, test::random_unit(rng), 0.3 + uniform(rng));
@@ -209,7 +218,8 @@ double point_kernel_cubature(const Polygon& p, const Polygon& q, int n) {
     double sum = 0.0;
     for (int i = 0; i < n; ++i) {
       for (int j = 0; j < n; ++j) {
-        sum += w[i] * w[j] * x[i] * form_factor(p[0] + x[i] * ((1 - x[j]) * e1 + x[j] * e2), normal, q);
+        sum += w[i] * w[j] * x[i] *
+               form_factor(p[0] + x[i] * ((1 - x[j]) * e1 + x[j] * e2), normal, q);
       }
     }
     total += glm::length(glm::cross(e1, e2)) * sum;
@@ -337,8 +347,9 @@ TEST(PatchFormFactor, InvariantUnderTranslationRotationScale) {
       // straddling sliver's F by more than 1e-9: compare with the same rounded
       // geometry moved back, exactly.
       const glm::dmat4 back = t == 0 ? glm::inverse(m) : identity;
-      const double reference = t == 0 ? patch_form_factor(transformed(p, back), transformed(q, back))
-                                      : patch_form_factor(pair.p, pair.q);
+      const double reference = t == 0
+                                   ? patch_form_factor(transformed(p, back), transformed(q, back))
+                                   : patch_form_factor(pair.p, pair.q);
       if (reference == 0.0) {
         EXPECT_LT(moved, 1e-12);
         continue;
@@ -365,7 +376,9 @@ TEST(PatchFormFactor, NothingFacingIsZero) {
   EXPECT_EQ(patch_form_factor(floor, floor_rectangle(0, 1, 0, 1)), 0.0);
   EXPECT_EQ(patch_form_factor(test::rectangle_facing_down(0, 1, 0, 1, 0), floor), 0.0);
   const Polygon above = floor_rectangle(0, 1, 0, 1);
-  EXPECT_EQ(patch_form_factor(floor, transformed(above, glm::translate(glm::dmat4(1.0), dvec3(0, 0, 1)))), 0.0);
+  EXPECT_EQ(
+      patch_form_factor(floor, transformed(above, glm::translate(glm::dmat4(1.0), dvec3(0, 0, 1)))),
+      0.0);
   const Polygon wall_behind = quad({0, 0, -2}, {0, 1, 0}, {0, 0, 1});
   EXPECT_EQ(patch_form_factor(floor, wall_behind), 0.0);
   EXPECT_EQ(patch_form_factor(wall_behind, floor), 0.0);
@@ -415,18 +428,21 @@ TEST(PatchFormFactor, TinyAndHugeDistances) {
 // Gauss-Kronrod split every interval down to depth 40 (2^40 of them: the solve
 // never returned). The subdivisions are now bounded.
 TEST(PatchFormFactor, NeighbourOneTrillionthTheSizeReturns) {
-  const Polygon quad_p = {{-4.721087714336642e-10, -4.2729275236462975e-09, -4.9719602538841866e-11},
-                          {5.020433486652835e-09, -3.2097653727151637e-09, -3.2096664895593493e-09},
-                          {4.3486241962839191e-09, -2.111938573966085e-09, -4.0080257994517912e-09},
-                          {-3.8029735139882818e-09, 1.1701537641651122e-09, -4.0080257994517904e-09}};
-  const Polygon tiny = {{-2.5779088494727169e-09, -2.3716603553894362e-11, -2.4121532306288478e-09},
-                        {-2.5779088494722595e-09, -2.3716603554321239e-11, -2.4121532306303872e-09},
-                        {-2.5779088494707292e-09, -2.3716603554665055e-11, -2.4121532306298371e-09},
-                        {-2.5779088494711866e-09, -2.3716603554238178e-11, -2.4121532306282978e-09}};
+  const Polygon quad_p = {
+      {-4.721087714336642e-10, -4.2729275236462975e-09, -4.9719602538841866e-11},
+      {5.020433486652835e-09, -3.2097653727151637e-09, -3.2096664895593493e-09},
+      {4.3486241962839191e-09, -2.111938573966085e-09, -4.0080257994517912e-09},
+      {-3.8029735139882818e-09, 1.1701537641651122e-09, -4.0080257994517904e-09}};
+  const Polygon tiny = {
+      {-2.5779088494727169e-09, -2.3716603553894362e-11, -2.4121532306288478e-09},
+      {-2.5779088494722595e-09, -2.3716603554321239e-11, -2.4121532306303872e-09},
+      {-2.5779088494707292e-09, -2.3716603554665055e-11, -2.4121532306298371e-09},
+      {-2.5779088494711866e-09, -2.3716603554238178e-11, -2.4121532306282978e-09}};
   const auto start = std::chrono::steady_clock::now();
   const double f = patch_form_factor(quad_p, tiny);
   const double back = patch_form_factor(tiny, quad_p);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_LT(seconds, 5.0);
   EXPECT_TRUE(std::isfinite(f));
   EXPECT_TRUE(std::isfinite(back));
@@ -453,7 +469,8 @@ TEST(PatchFormFactor, SmallWallOnALargeFloorAtAnyRatio) {
     worst = std::max(worst, std::abs(f - 0.5) / (s / half));
     EXPECT_LE(f, 0.5 + 1e-9) << s;
     EXPECT_NEAR(f, 0.5, 2.0 * s / half + 1e-9) << s;
-    EXPECT_NEAR(patch_form_factor(floor, wall) * area(floor), f * area(wall), 1e-9 * f * area(wall)) << s;
+    EXPECT_NEAR(patch_form_factor(floor, wall) * area(floor), f * area(wall), 1e-9 * f * area(wall))
+        << s;
   }
   std::printf("small wall on a large floor: |F - 1/2| <= %.2f s / L\n", worst);
 }

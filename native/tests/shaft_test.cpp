@@ -1,6 +1,8 @@
 // Shaft culling (Haines and Wallace): the BVH query finds exactly the triangles a
 // brute-force scan finds, never misses a triangle that blocks a segment between
 // the two elements, and its "clear" and "hidden" answers are right.
+#include "core/shaft.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -8,7 +10,6 @@
 #include <vector>
 
 #include "core/sampled_visibility.h"
-#include "core/shaft.h"
 
 namespace radiosity {
 namespace {
@@ -44,8 +45,9 @@ OccluderScene random_scene(std::mt19937_64& rng, int count) {
     const dvec3 c = random_point(rng, -5.0, 5.0);
     // Mostly small triangles, a few large ones that can hide a whole link.
     const double size = i % 50 == 0 ? 4.0 : 0.4;
-    triangles.push_back(Triangle{{c + random_point(rng, -size, size), c + random_point(rng, -size, size),
-                                  c + random_point(rng, -size, size)}});
+    triangles.push_back(
+        Triangle{{c + random_point(rng, -size, size), c + random_point(rng, -size, size),
+                  c + random_point(rng, -size, size)}});
   }
   return make_occluder_scene(std::move(triangles));
 }
@@ -124,35 +126,41 @@ TEST(ShaftCulling, WallBetweenTwoElementsIsHidden) {
   const Polygon floor{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
   const Polygon ceiling{{0, 0, 2}, {0, 1, 2}, {1, 1, 2}, {1, 0, 2}};
   OccluderScene scene = make_occluder_scene(triangles, {0, 0});
-  EXPECT_EQ(cull_shaft(scene, floor, kNoFace, ceiling, kNoFace).visibility, ShaftVisibility::hidden);
+  EXPECT_EQ(cull_shaft(scene, floor, kNoFace, ceiling, kNoFace).visibility,
+            ShaftVisibility::hidden);
   // As two faces: neither alone covers the shaft's cross-section, together they do.
   scene = make_occluder_scene(triangles, {0, 1});
-  EXPECT_EQ(cull_shaft(scene, floor, kNoFace, ceiling, kNoFace).visibility, ShaftVisibility::hidden);
+  EXPECT_EQ(cull_shaft(scene, floor, kNoFace, ceiling, kNoFace).visibility,
+            ShaftVisibility::hidden);
   // A wall of 8 x 8 quads (128 triangles, one face each): hidden.
   std::vector<Triangle> tiles;
   for (int i = 0; i < 8; ++i)
     for (int j = 0; j < 8; ++j) {
-      const dvec3 a(-3 + 0.75 * i, -3 + 0.75 * j, 1), b = a + dvec3(0.75, 0, 0),
-                  c = a + dvec3(0.75, 0.75, 0), d = a + dvec3(0, 0.75, 0);
+      const dvec3 a(-3 + 0.75 * i, -3 + 0.75 * j, 1),
+          b = a + dvec3(0.75, 0, 0), c = a + dvec3(0.75, 0.75, 0), d = a + dvec3(0, 0.75, 0);
       tiles.push_back(Triangle{{a, b, c}});
       tiles.push_back(Triangle{{a, c, d}});
     }
   scene = make_occluder_scene(tiles);
-  EXPECT_EQ(cull_shaft(scene, floor, kNoFace, ceiling, kNoFace).visibility, ShaftVisibility::hidden);
+  EXPECT_EQ(cull_shaft(scene, floor, kNoFace, ceiling, kNoFace).visibility,
+            ShaftVisibility::hidden);
   // The same wall with one tile missing inside the shaft: light gets through.
   std::vector<Triangle> holed;
   for (const Triangle& t : tiles)
     if (!(t.v[0].x == 0.0 && t.v[0].y == 0.0)) holed.push_back(t);
   ASSERT_EQ(holed.size(), tiles.size() - 2);
   scene = make_occluder_scene(holed);
-  EXPECT_EQ(cull_shaft(scene, floor, kNoFace, ceiling, kNoFace).visibility, ShaftVisibility::partial);
+  EXPECT_EQ(cull_shaft(scene, floor, kNoFace, ceiling, kNoFace).visibility,
+            ShaftVisibility::partial);
   // Two halves with a crack of 1e-3 between them: partial.
-  std::vector<Triangle> cracked{Triangle{{dvec3(-3, -3, 1), dvec3(0.5, -3, 1), dvec3(0.5, 3, 1)}},
-                                Triangle{{dvec3(-3, -3, 1), dvec3(0.5, 3, 1), dvec3(-3, 3, 1)}},
-                                Triangle{{dvec3(0.501, -3, 1), dvec3(3, -3, 1), dvec3(3, 3, 1)}},
-                                Triangle{{dvec3(0.501, -3, 1), dvec3(3, 3, 1), dvec3(0.501, 3, 1)}}};
+  std::vector<Triangle> cracked{
+      Triangle{{dvec3(-3, -3, 1), dvec3(0.5, -3, 1), dvec3(0.5, 3, 1)}},
+      Triangle{{dvec3(-3, -3, 1), dvec3(0.5, 3, 1), dvec3(-3, 3, 1)}},
+      Triangle{{dvec3(0.501, -3, 1), dvec3(3, -3, 1), dvec3(3, 3, 1)}},
+      Triangle{{dvec3(0.501, -3, 1), dvec3(3, 3, 1), dvec3(0.501, 3, 1)}}};
   scene = make_occluder_scene(cracked);
-  EXPECT_EQ(cull_shaft(scene, floor, kNoFace, ceiling, kNoFace).visibility, ShaftVisibility::partial);
+  EXPECT_EQ(cull_shaft(scene, floor, kNoFace, ceiling, kNoFace).visibility,
+            ShaftVisibility::partial);
   // The wall is the receiver's own face: ignored, so the link is clear.
   scene = make_occluder_scene(triangles, {0, 0});
   EXPECT_EQ(cull_shaft(scene, floor, 0, ceiling, kNoFace).visibility, ShaftVisibility::clear);

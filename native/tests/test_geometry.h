@@ -2,8 +2,8 @@
 // finite differences.
 #pragma once
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <random>
 #include <vector>
@@ -56,7 +56,8 @@ struct RandomConfiguration {
 inline dvec3 random_unit(std::mt19937_64& rng) {
   std::normal_distribution<double> normal(0.0, 1.0);
   dvec3 v;
-  do v = {normal(rng), normal(rng), normal(rng)}; while (glm::length(v) < 1e-3);
+  do v = {normal(rng), normal(rng), normal(rng)};
+  while (glm::length(v) < 1e-3);
   return glm::normalize(v);
 }
 
@@ -83,7 +84,8 @@ inline std::vector<dvec3> random_polygon(std::mt19937_64& rng, const dvec3& cent
   std::vector<dvec3> polygon;
   for (int i = 0; i < k; ++i) {
     const double radius = convex ? 1.0 : 0.35 + 0.65 * uniform(rng);
-    polygon.push_back(centre + radius * (rx * std::cos(angles[i]) * t1 + ry * std::sin(angles[i]) * t2));
+    polygon.push_back(centre +
+                      radius * (rx * std::cos(angles[i]) * t1 + ry * std::sin(angles[i]) * t2));
   }
   return polygon;
 }
@@ -97,13 +99,15 @@ inline RandomConfiguration random_configuration(std::mt19937_64& rng, bool conve
   c.polygon = random_polygon(rng, centre, c.emitter_normal, size, convex);
   // Receiver in front of the emitter, at a distance comparable to its size.
   dvec3 direction;
-  do direction = random_unit(rng); while (glm::dot(direction, c.emitter_normal) < 0.15);
+  do direction = random_unit(rng);
+  while (glm::dot(direction, c.emitter_normal) < 0.15);
   c.scale = size * (0.5 + 3 * uniform(rng));
   c.point = centre + c.scale * direction;
   // Any normal that sees some of the emitter, including grazing ones: the
   // emitter may straddle the horizon.
   const dvec3 towards_emitter = glm::normalize(centre - c.point);
-  do c.normal = random_unit(rng); while (glm::dot(c.normal, towards_emitter) < -0.3);
+  do c.normal = random_unit(rng);
+  while (glm::dot(c.normal, towards_emitter) < -0.3);
   return c;
 }
 

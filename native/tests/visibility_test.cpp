@@ -61,8 +61,8 @@ MonteCarlo monte_carlo_form_factor(const dvec3& r, const dvec3& n, const Polygon
       a = 1.0 - a;
       b = 1.0 - b;
     }
-    const dvec3 y = emitter[0] + a * (emitter[tri + 1] - emitter[0]) +
-                    b * (emitter[tri + 2] - emitter[0]);
+    const dvec3 y =
+        emitter[0] + a * (emitter[tri + 1] - emitter[0]) + b * (emitter[tri + 2] - emitter[0]);
     const dvec3 d = y - r;
     const double d2 = glm::dot(d, d);
     const double cr = glm::dot(n, d), ce = -glm::dot(ne, d);
@@ -215,9 +215,11 @@ TEST(VisiblePolygon, GradientMatchesFiniteDifferences) {
       dvec3 e(0.0);
       e[k] = 1.0;
       fd[k] = (visible_f(c.r + h * e, c.n, c.emitter, c.occluders) -
-               visible_f(c.r - h * e, c.n, c.emitter, c.occluders)) / (2.0 * h);
+               visible_f(c.r - h * e, c.n, c.emitter, c.occluders)) /
+              (2.0 * h);
       fd_half[k] = (visible_f(c.r + 0.5 * h * e, c.n, c.emitter, c.occluders) -
-                    visible_f(c.r - 0.5 * h * e, c.n, c.emitter, c.occluders)) / h;
+                    visible_f(c.r - 0.5 * h * e, c.n, c.emitter, c.occluders)) /
+                   h;
     }
     // Richardson: the two estimates differ by 3/4 of the h^2 error of the coarse one.
     const dvec3 richardson = (4.0 * fd_half - fd) / 3.0;
@@ -295,8 +297,9 @@ TEST(VisiblePolygon, GradientMatchesFiniteDifferencesWithTracesBoxesAndHorizon) 
     if (c.n.z < 0.2) c.n.z = 0.2;
     c.n = glm::normalize(c.n);
     const dvec3 centre(0.6 * (uni(rng) - 0.5), 0.6 * (uni(rng) - 0.5), 2.0);
-    c.occluders.push_back(Triangle{{centre + dvec3(-0.3, -0.2, -0.4), centre + dvec3(0.3, -0.1, 0.4),
-                                    centre + random_in_ball(rng, 0.3) - dvec3(0.0, 0.0, 0.3)}});
+    c.occluders.push_back(
+        Triangle{{centre + dvec3(-0.3, -0.2, -0.4), centre + dvec3(0.3, -0.1, 0.4),
+                  centre + random_in_ball(rng, 0.3) - dvec3(0.0, 0.0, 0.3)}});
     const dvec3 lo = c.r + (0.3 + 0.4 * uni(rng)) * (centre - c.r) - dvec3(0.1, 0.1, 0.1);
     for (const Triangle& t : box(lo, lo + dvec3(0.1 + 0.2 * uni(rng), 0.1 + 0.2 * uni(rng), 0.2)))
       c.occluders.push_back(t);
@@ -308,9 +311,11 @@ TEST(VisiblePolygon, GradientMatchesFiniteDifferencesWithTracesBoxesAndHorizon) 
       dvec3 e(0.0);
       e[k] = 1.0;
       fd[k] = (visible_f(c.r + h * e, c.n, c.emitter, c.occluders) -
-               visible_f(c.r - h * e, c.n, c.emitter, c.occluders)) / (2.0 * h);
+               visible_f(c.r - h * e, c.n, c.emitter, c.occluders)) /
+              (2.0 * h);
       fd_half[k] = (visible_f(c.r + 0.5 * h * e, c.n, c.emitter, c.occluders) -
-                    visible_f(c.r - 0.5 * h * e, c.n, c.emitter, c.occluders)) / h;
+                    visible_f(c.r - 0.5 * h * e, c.n, c.emitter, c.occluders)) /
+                   h;
     }
     const dvec3 richardson = (4.0 * fd_half - fd) / 3.0;
     const double scale = std::max(glm::length(richardson), 1e-3);
@@ -323,8 +328,10 @@ TEST(VisiblePolygon, GradientMatchesFiniteDifferencesWithTracesBoxesAndHorizon) 
     worst = std::max(worst, error);
     EXPECT_LT(error, 1e-5) << "configuration " << i;
   }
-  std::printf("gradient vs finite differences (traces, boxes, horizon): %d tested, %d skipped, "
-              "worst relative error %.3g\n", tested, skipped, worst);
+  std::printf(
+      "gradient vs finite differences (traces, boxes, horizon): %d tested, %d skipped, "
+      "worst relative error %.3g\n",
+      tested, skipped, worst);
   EXPECT_GE(tested, 100);
   EXPECT_LE(skipped, tested / 10);
 }
@@ -334,11 +341,15 @@ TEST(VisiblePolygon, GradientMatchesFiniteDifferencesWithTracesBoxesAndHorizon) 
 std::vector<Polygon> children_of(const Polygon& p) {
   const auto mid = [&](size_t i, size_t j) { return 0.5 * (p[i] + p[j]); };
   if (p.size() == 3) {
-    return {{p[0], mid(0, 1), mid(2, 0)}, {mid(0, 1), p[1], mid(1, 2)}, {mid(2, 0), mid(1, 2), p[2]},
+    return {{p[0], mid(0, 1), mid(2, 0)},
+            {mid(0, 1), p[1], mid(1, 2)},
+            {mid(2, 0), mid(1, 2), p[2]},
             {mid(0, 1), mid(1, 2), mid(2, 0)}};
   }
   const dvec3 c = 0.25 * (p[0] + p[1] + p[2] + p[3]);
-  return {{p[0], mid(0, 1), c, mid(3, 0)}, {mid(0, 1), p[1], mid(1, 2), c}, {c, mid(1, 2), p[2], mid(2, 3)},
+  return {{p[0], mid(0, 1), c, mid(3, 0)},
+          {mid(0, 1), p[1], mid(1, 2), c},
+          {c, mid(1, 2), p[2], mid(2, 3)},
           {mid(3, 0), c, mid(2, 3), p[3]}};
 }
 
@@ -358,11 +369,15 @@ TEST(VisiblePolygon, PartsOfASplitEmitterMatchOneCallPerPart) {
     const double scale = std::max(whole.value, 1e-3);
     double sum = 0.0;
     for (size_t k = 0; k < children.size(); ++k) {
-      const FormFactorGradient alone = visible_form_factor_gradient(c.r, c.n, children[k], c.occluders);
-      const double gradient_scale = std::max(glm::length(alone.gradient), glm::length(whole.gradient)) + 1e-3;
+      const FormFactorGradient alone =
+          visible_form_factor_gradient(c.r, c.n, children[k], c.occluders);
+      const double gradient_scale =
+          std::max(glm::length(alone.gradient), glm::length(whole.gradient)) + 1e-3;
       worst_value = std::max(worst_value, std::abs(together[k].value - alone.value) / scale);
-      worst_gradient = std::max(worst_gradient, glm::length(together[k].gradient - alone.gradient) / gradient_scale);
-      EXPECT_NEAR(together[k].value, alone.value, 1e-10 * scale) << "configuration " << i << " part " << k;
+      worst_gradient = std::max(
+          worst_gradient, glm::length(together[k].gradient - alone.gradient) / gradient_scale);
+      EXPECT_NEAR(together[k].value, alone.value, 1e-10 * scale)
+          << "configuration " << i << " part " << k;
       EXPECT_LT(glm::length(together[k].gradient - alone.gradient), 1e-8 * gradient_scale)
           << "configuration " << i << " part " << k;
       sum += together[k].value;
@@ -370,8 +385,9 @@ TEST(VisiblePolygon, PartsOfASplitEmitterMatchOneCallPerPart) {
     EXPECT_NEAR(sum, whole.value, 1e-10 * scale) << "configuration " << i;
     occluded += whole.value < form_factor(c.r, c.n, c.emitter) * (1.0 - 1e-9) ? 1 : 0;
   }
-  std::printf("split emitter: worst value error %.3g, worst gradient error %.3g, %d of 300 occluded\n",
-              worst_value, worst_gradient, occluded);
+  std::printf(
+      "split emitter: worst value error %.3g, worst gradient error %.3g, %d of 300 occluded\n",
+      worst_value, worst_gradient, occluded);
   EXPECT_GE(occluded, 150);
 }
 
@@ -381,7 +397,8 @@ TEST(VisiblePolygon, AlignedOccluderHidesExactlyHalf) {
   // equal F by symmetry.
   const dvec3 r(0.0), n(0.0, 0.0, 1.0);
   const Polygon emitter = math_emitter();
-  const auto occluder = quad({0.0, -0.25, 1.0}, {0.25, -0.25, 1.0}, {0.25, 0.25, 1.0}, {0.0, 0.25, 1.0});
+  const auto occluder =
+      quad({0.0, -0.25, 1.0}, {0.25, -0.25, 1.0}, {0.25, 0.25, 1.0}, {0.0, 0.25, 1.0});
   const FormFactorGradient fg = visible_form_factor_gradient(r, n, emitter, occluder);
   const FormFactorGradient half = form_factor_gradient(
       r, n, Polygon{{-0.5, -0.5, 2.0}, {-0.5, 0.5, 2.0}, {0.0, 0.5, 2.0}, {0.0, -0.5, 2.0}});
@@ -391,7 +408,8 @@ TEST(VisiblePolygon, AlignedOccluderHidesExactlyHalf) {
   // Same with the occluder split in two along x = 1/8 and given twice (a closed,
   // flat mesh): the shared edge and the duplicate change nothing.
   auto split = quad({0.0, -0.25, 1.0}, {0.125, -0.25, 1.0}, {0.125, 0.25, 1.0}, {0.0, 0.25, 1.0});
-  const auto right = quad({0.125, -0.25, 1.0}, {0.25, -0.25, 1.0}, {0.25, 0.25, 1.0}, {0.125, 0.25, 1.0});
+  const auto right =
+      quad({0.125, -0.25, 1.0}, {0.25, -0.25, 1.0}, {0.25, 0.25, 1.0}, {0.125, 0.25, 1.0});
   split.insert(split.end(), right.begin(), right.end());
   split.insert(split.end(), occluder.begin(), occluder.end());
   EXPECT_NEAR(visible_f(r, n, emitter, split), half.value, 1e-15);
@@ -404,7 +422,8 @@ TEST(VisiblePolygon, OccluderCrossingTheEmitterPlaneIsClippedThere) {
   const Triangle through{{dvec3(-0.2, -0.1, 1.5), dvec3(0.3, -0.1, 2.5), dvec3(0.0, 0.3, 1.5)}};
   // Its part with z <= 2: the quad (-0.2,-0.1,1.5), (0.05,-0.1,2), (0.15,0.1,2), (0,0.3,1.5).
   const auto front = quad({-0.2, -0.1, 1.5}, {0.05, -0.1, 2.0}, {0.15, 0.1, 2.0}, {0.0, 0.3, 1.5});
-  const FormFactorGradient a = visible_form_factor_gradient(r, n, emitter, std::vector<Triangle>{through});
+  const FormFactorGradient a =
+      visible_form_factor_gradient(r, n, emitter, std::vector<Triangle>{through});
   const FormFactorGradient b = visible_form_factor_gradient(r, n, emitter, front);
   EXPECT_NEAR(a.value, b.value, 1e-14);
   EXPECT_NEAR(glm::length(a.gradient - b.gradient), 0.0, 1e-12);
@@ -419,37 +438,50 @@ TEST(VisiblePolygon, DegenerateConfigurations) {
   const double unoccluded = form_factor(r, n, emitter);
 
   // Touching the emitter: an edge lying on the emitter, inside it.
-  expect_sane(r, n, emitter, {Triangle{{dvec3(-0.3, 0.0, 2.0), dvec3(0.2, 0.1, 2.0), dvec3(0.0, 0.0, 1.4)}}},
+  expect_sane(r, n, emitter,
+              {Triangle{{dvec3(-0.3, 0.0, 2.0), dvec3(0.2, 0.1, 2.0), dvec3(0.0, 0.0, 1.4)}}},
               200000, "edge on the emitter");
   // Touching the emitter at a vertex only, and along the emitter's own edge.
-  expect_sane(r, n, emitter, {Triangle{{dvec3(0.0, 0.0, 2.0), dvec3(0.3, 0.1, 1.5), dvec3(-0.1, 0.3, 1.6)}}},
+  expect_sane(r, n, emitter,
+              {Triangle{{dvec3(0.0, 0.0, 2.0), dvec3(0.3, 0.1, 1.5), dvec3(-0.1, 0.3, 1.6)}}},
               200000, "vertex on the emitter");
-  expect_sane(r, n, emitter, {Triangle{{dvec3(-0.5, -0.5, 2.0), dvec3(0.5, -0.5, 2.0), dvec3(0.0, 0.0, 1.5)}}},
+  expect_sane(r, n, emitter,
+              {Triangle{{dvec3(-0.5, -0.5, 2.0), dvec3(0.5, -0.5, 2.0), dvec3(0.0, 0.0, 1.5)}}},
               200000, "edge on the emitter's edge");
   // Touching the receiver: a vertex at r, an edge through r (planes holding r
   // project to segments and hide nothing of positive measure).
   expect_sane(r, n, emitter, {Triangle{{r, dvec3(0.2, 0.1, 1.0), dvec3(0.0, 0.3, 1.2)}}}, 200000,
               "vertex at the receiver");
-  EXPECT_NEAR(visible_f(r, n, emitter, {Triangle{{r - dvec3(0.5, 0, 0), r + dvec3(0.5, 0, 0), dvec3(0.0, 0.1, 1.5)}}}),
-              unoccluded, 1e-15);
+  EXPECT_NEAR(
+      visible_f(r, n, emitter,
+                {Triangle{{r - dvec3(0.5, 0, 0), r + dvec3(0.5, 0, 0), dvec3(0.0, 0.1, 1.5)}}}),
+      unoccluded, 1e-15);
   // A triangle near the receiver, reaching below and behind it.
-  expect_sane(r, n, emitter, {Triangle{{dvec3(-0.5, -0.4, -0.3), dvec3(0.3, 0.6, -0.3), dvec3(0.1, 0.0, 0.2)}}},
+  expect_sane(r, n, emitter,
+              {Triangle{{dvec3(-0.5, -0.4, -0.3), dvec3(0.3, 0.6, -0.3), dvec3(0.1, 0.0, 0.2)}}},
               200000, "through the receiver's plane");
   // Coplanar with the emitter (a neighbour or an overlapping face): hides nothing.
-  EXPECT_EQ(visible_f(r, n, emitter, quad({-1, -1, 2}, {1, -1, 2}, {1, 1, 2}, {-1, 1, 2})), unoccluded);
+  EXPECT_EQ(visible_f(r, n, emitter, quad({-1, -1, 2}, {1, -1, 2}, {1, 1, 2}, {-1, 1, 2})),
+            unoccluded);
   // Coplanar with the receiver's tangent plane, and holding r.
-  EXPECT_NEAR(visible_f(r, n, emitter, {Triangle{{r + dvec3(1, 0, -0.1), r + dvec3(-1, 1, 0.2), r + dvec3(-1, -1, 0.0)}}}),
-              unoccluded, 1e-15);
+  EXPECT_NEAR(
+      visible_f(r, n, emitter,
+                {Triangle{{r + dvec3(1, 0, -0.1), r + dvec3(-1, 1, 0.2), r + dvec3(-1, -1, 0.0)}}}),
+      unoccluded, 1e-15);
   // Behind the emitter, behind the receiver: nothing.
-  EXPECT_EQ(visible_f(r, n, emitter, quad({-1, -1, 2.5}, {1, -1, 2.5}, {1, 1, 2.5}, {-1, 1, 2.5})), unoccluded);
-  EXPECT_EQ(visible_f(r, n, emitter, quad({-1, -1, -0.5}, {1, -1, -0.5}, {1, 1, -0.5}, {-1, 1, -0.5})), unoccluded);
+  EXPECT_EQ(visible_f(r, n, emitter, quad({-1, -1, 2.5}, {1, -1, 2.5}, {1, 1, 2.5}, {-1, 1, 2.5})),
+            unoccluded);
+  EXPECT_EQ(
+      visible_f(r, n, emitter, quad({-1, -1, -0.5}, {1, -1, -0.5}, {1, 1, -0.5}, {-1, 1, -0.5})),
+      unoccluded);
   // A floor-to-ceiling blocker larger than the pyramid: all hidden.
   const auto wall = quad({-5, -5, 1}, {5, -5, 1}, {5, 5, 1}, {-5, 5, 1});
   const FormFactorGradient hidden = visible_form_factor_gradient(r, n, emitter, wall);
   EXPECT_EQ(hidden.value, 0.0);
   EXPECT_EQ(hidden.gradient, dvec3(0.0));
   // A tiny occluder changes almost nothing and stays finite.
-  const double tiny = visible_f(r, n, emitter, {Triangle{{dvec3(0, 0, 1), dvec3(1e-9, 0, 1), dvec3(0, 1e-9, 1)}}});
+  const double tiny =
+      visible_f(r, n, emitter, {Triangle{{dvec3(0, 0, 1), dvec3(1e-9, 0, 1), dvec3(0, 1e-9, 1)}}});
   EXPECT_LE(tiny, unoccluded);
   EXPECT_NEAR(tiny, unoccluded, 1e-15);
   // Closed meshes, front and back faces: a box in the way, boxes overlapping.
@@ -474,17 +506,20 @@ TEST(VisiblePolygon, DegenerateConfigurations) {
 // vertex last: merge_into_quad read b.v[-1] (UBSan in make sanitize found it
 // through DegenerateFuzz); this case fails there without the fix.
 TEST(VisiblePolygon, DegenerateTriangleBeforeANeighbourSharingItsVertex) {
-  const std::vector<dvec3> emitter = {{-0.5, -0.5, 2.0}, {-0.5, 0.5, 2.0}, {0.5, 0.5, 2.0}, {0.5, -0.5, 2.0}};
+  const std::vector<dvec3> emitter = {
+      {-0.5, -0.5, 2.0}, {-0.5, 0.5, 2.0}, {0.5, 0.5, 2.0}, {0.5, -0.5, 2.0}};
   const dvec3 p(0.1, 0.05, 1.0), q(0.45, -0.1, 0.9);
   Triangle a, b;
   a.v = {p, p, q};
   b.v = {dvec3(-0.2, 0.1, 1.1), dvec3(0.3, 0.3, 1.2), p};
   const std::vector<Triangle> occluders = {a, b};
-  const FormFactorGradient fg = visible_form_factor_gradient(dvec3(0.0), dvec3(0, 0, 1), emitter, occluders);
+  const FormFactorGradient fg =
+      visible_form_factor_gradient(dvec3(0.0), dvec3(0, 0, 1), emitter, occluders);
   const double unoccluded = form_factor(dvec3(0.0), dvec3(0, 0, 1), emitter);
   EXPECT_TRUE(std::isfinite(fg.value) && std::isfinite(glm::length(fg.gradient)));
   // b alone is in the way (a has no area).
-  const FormFactorGradient b_only = visible_form_factor_gradient(dvec3(0.0), dvec3(0, 0, 1), emitter, std::vector<Triangle>{b});
+  const FormFactorGradient b_only =
+      visible_form_factor_gradient(dvec3(0.0), dvec3(0, 0, 1), emitter, std::vector<Triangle>{b});
   EXPECT_NEAR(fg.value, b_only.value, 1e-12);
   EXPECT_LT(fg.value, unoccluded);
 }
@@ -503,13 +538,20 @@ TEST(VisiblePolygon, DegenerateFuzz) {
       const dvec3 a = c.emitter[e], b = c.emitter[(e + 1) % k];
       const double t = uni(rng);
       switch (rng() % 8) {
-        case 0: return a;                                              // emitter vertex
-        case 1: return a + t * (b - a);                                // on an emitter edge
-        case 2: return c.r + (0.2 + 0.6 * t) * (a - c.r);              // on the ray to a vertex
-        case 3: return c.r + (0.2 + 0.6 * t) * (a + uni(rng) * (b - a) - c.r);  // plane r, edge
-        case 4: return c.r;                                            // at the receiver
-        case 5: return centre + (uni(rng) - 0.5) * (b - a) + (uni(rng) - 0.5) * (a - centre);
-        default: return c.r + (0.1 + 0.8 * t) * (centre - c.r) + random_in_ball(rng, 0.4);
+        case 0:
+          return a;  // emitter vertex
+        case 1:
+          return a + t * (b - a);  // on an emitter edge
+        case 2:
+          return c.r + (0.2 + 0.6 * t) * (a - c.r);  // on the ray to a vertex
+        case 3:
+          return c.r + (0.2 + 0.6 * t) * (a + uni(rng) * (b - a) - c.r);  // plane r, edge
+        case 4:
+          return c.r;  // at the receiver
+        case 5:
+          return centre + (uni(rng) - 0.5) * (b - a) + (uni(rng) - 0.5) * (a - centre);
+        default:
+          return c.r + (0.1 + 0.8 * t) * (centre - c.r) + random_in_ball(rng, 0.4);
       }
     };
     const int count = 1 + static_cast<int>(rng() % 6);
@@ -524,7 +566,8 @@ TEST(VisiblePolygon, DegenerateFuzz) {
           const dvec3 along = c.emitter[(e + 1) % k] - c.emitter[e];
           const double f = 0.2 + 0.6 * uni(rng);
           const dvec3 base = c.r + f * (centre - c.r);
-          const dvec3 normal = glm::normalize(glm::cross(c.emitter[1] - c.emitter[0], c.emitter[2] - c.emitter[0]));
+          const dvec3 normal =
+              glm::normalize(glm::cross(c.emitter[1] - c.emitter[0], c.emitter[2] - c.emitter[0]));
           t.v = {base, base + 0.5 * along, base + 0.4 * glm::cross(normal, along) + 0.1 * along};
           break;
         }
@@ -562,13 +605,15 @@ TEST(VisiblePolygon, DegenerateFuzz) {
       const double sigmas = std::abs(fg.value - mc.mean) / (mc.standard_error + 1e-300);
       worst_sigmas = std::max(worst_sigmas, std::abs(fg.value - mc.mean) > 1e-12 ? sigmas : 0.0);
       EXPECT_LT(std::abs(fg.value - mc.mean), 4.5 * mc.standard_error + 1e-12)
-          << "case " << i << ": exact " << fg.value << " mc " << mc.mean << " +- " << mc.standard_error;
+          << "case " << i << ": exact " << fg.value << " mc " << mc.mean << " +- "
+          << mc.standard_error;
       ++against_monte_carlo;
     }
   }
-  std::printf("degenerate fuzz: %d configurations (%d occluded), %d against Monte Carlo (worst "
-              "%.2f sigma), largest |grad F| %.3g\n", checked, occluded, against_monte_carlo,
-              worst_sigmas, largest_gradient);
+  std::printf(
+      "degenerate fuzz: %d configurations (%d occluded), %d against Monte Carlo (worst "
+      "%.2f sigma), largest |grad F| %.3g\n",
+      checked, occluded, against_monte_carlo, worst_sigmas, largest_gradient);
   EXPECT_GT(occluded, checked / 2);
 }
 
@@ -582,7 +627,8 @@ TEST(VisiblePolygon, MergedQuadsEqualTheirTriangles) {
     Configuration c = random_configuration(rng, 0, 0.0);
     std::vector<Triangle> together;
     for (int b = 0; b < 3; ++b) {
-      const dvec3 lo = c.r + (0.3 + 0.4 * uni(rng)) * (dvec3(0.4 * (uni(rng) - 0.5), 0.4 * (uni(rng) - 0.5), 2.0) - c.r);
+      const dvec3 lo = c.r + (0.3 + 0.4 * uni(rng)) *
+                                 (dvec3(0.4 * (uni(rng) - 0.5), 0.4 * (uni(rng) - 0.5), 2.0) - c.r);
       for (const Triangle& t : box(lo, lo + dvec3(0.1 + 0.3 * uni(rng), 0.1 + 0.3 * uni(rng), 0.2)))
         together.push_back(t);
     }
@@ -703,7 +749,8 @@ TEST(SampledVisibility, ConvergesToExactAsRaysGrow) {
       options.rays = ray_counts[k];
       options.seed = static_cast<std::uint64_t>(i);
       const double a = sampled_form_factor_gradient(c.r, c.n, c.emitter, scene, options).value;
-      const double b = sampled_form_factor_gradient(c.r, c.n, c.emitter, c.occluders, options).value;
+      const double b =
+          sampled_form_factor_gradient(c.r, c.n, c.emitter, c.occluders, options).value;
       EXPECT_GE(a, 0.0);
       EXPECT_LE(a, unoccluded);
       embree_error[k] += std::abs(a - exact) / unoccluded / configurations;
@@ -711,8 +758,10 @@ TEST(SampledVisibility, ConvergesToExactAsRaysGrow) {
     }
   }
   for (std::size_t k = 0; k < ray_counts.size(); ++k)
-    std::printf("sampled visibility, %5d rays: mean |F - exact| / F_unoccluded = %.2e (Embree), %.2e (own rays)\n",
-                ray_counts[k], embree_error[k], own_error[k]);
+    std::printf(
+        "sampled visibility, %5d rays: mean |F - exact| / F_unoccluded = %.2e (Embree), %.2e (own "
+        "rays)\n",
+        ray_counts[k], embree_error[k], own_error[k]);
   // Stratified sampling of a shadow boundary converges like N^-3/4: 256 times
   // more rays should gain far more than a factor 10.
   EXPECT_LT(embree_error.back(), 0.1 * embree_error[1]);
@@ -755,7 +804,8 @@ TEST(SampledVisibility, VectorisedRaysAgreeWithTheReferenceTest) {
     for (std::size_t k = 0; k < samples.points.size(); ++k)
       for (const Triangle& t : c.occluders)
         blocked[k] = blocked[k] || segment_hits_triangle(c.r, samples.points[k], t);
-    EXPECT_DOUBLE_EQ(visible_fraction(c.occluders, c.r, samples), visible_fraction(samples, blocked))
+    EXPECT_DOUBLE_EQ(visible_fraction(c.occluders, c.r, samples),
+                     visible_fraction(samples, blocked))
         << "configuration " << i;
   }
 }

@@ -60,8 +60,8 @@ namespace {
 struct Scene {
   std::string name;
   std::string caption;
-  std::vector<dvec3> emitter;          // at z = 2, facing down
-  std::vector<dvec3> occluder;         // square at z = 1 (its outline)
+  std::vector<dvec3> emitter;   // at z = 2, facing down
+  std::vector<dvec3> occluder;  // square at z = 1 (its outline)
   std::vector<Triangle> occluder_triangles;
 };
 
@@ -77,7 +77,8 @@ std::vector<dvec3> square(double side, double z, double angle, bool facing_down)
   return out;
 }
 
-Scene make_scene(std::string name, std::string caption, double emitter_side, double occluder_angle) {
+Scene make_scene(std::string name, std::string caption, double emitter_side,
+                 double occluder_angle) {
   Scene s;
   s.name = std::move(name);
   s.caption = std::move(caption);
@@ -109,8 +110,8 @@ void evaluate(const Scene& s, int size, Field& f, Field& grad) {
   const dvec3 n(0.0, 0.0, 1.0);
   tbb::parallel_for(0, size, [&](int y) {
     for (int x = 0; x < size; ++x) {
-      const FormFactorGradient fg =
-          visible_form_factor_gradient(receiver_point(x, y, size), n, s.emitter, s.occluder_triangles);
+      const FormFactorGradient fg = visible_form_factor_gradient(receiver_point(x, y, size), n,
+                                                                 s.emitter, s.occluder_triangles);
       const std::size_t i = static_cast<std::size_t>(y) * size + x;
       f.value[i] = fg.value;
       grad.value[i] = std::hypot(fg.gradient.x, fg.gradient.y);
@@ -164,7 +165,9 @@ Image shaded_relief(const Field& f) {
 }
 
 // Central projection of point p from centre c onto the plane z = 0.
-dvec3 project_to_receiver(const dvec3& c, const dvec3& p) { return c + (p - c) * (c.z / (c.z - p.z)); }
+dvec3 project_to_receiver(const dvec3& c, const dvec3& p) {
+  return c + (p - c) * (c.z / (c.z - p.z));
+}
 
 void draw_segment(Image& img, int n, const dvec3& a, const dvec3& b, const dvec3& colour) {
   const auto to_pixel = [&](const dvec3& p) {
@@ -209,8 +212,8 @@ bool write_png(const std::filesystem::path& path, const Image& img, int n) {
   // sRGB-ish encoding of the linear colours, so mid tones are not crushed.
   std::vector<unsigned char> bytes(img.size());
   for (std::size_t i = 0; i < img.size(); ++i)
-    bytes[i] = static_cast<unsigned char>(
-        std::lround(255.0 * std::pow(std::clamp(static_cast<double>(img[i]), 0.0, 1.0), 1.0 / 2.2)));
+    bytes[i] = static_cast<unsigned char>(std::lround(
+        255.0 * std::pow(std::clamp(static_cast<double>(img[i]), 0.0, 1.0), 1.0 / 2.2)));
   const bool ok = out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
   return out->close() && ok;
 }
