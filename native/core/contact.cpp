@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <vector>
 
+#include "core/polygon.h"
 #include "core/scene_bvh.h"
 #include "core/triangle.h"
 
@@ -35,8 +36,6 @@ constexpr double kNarrowest = 0.01;
 // on them sits a millionth from a face that meets it, where the oracles see a
 // near-singular gradient and refine (at 2 %: 1.4 times the links of 5 %).
 constexpr double kSmallest = 0.05;
-
-double cross2(const dvec2& a, const dvec2& b) { return a.x * b.y - a.y * b.x; }
 
 // A corner of a piece: in the plane of the patch being cut, and in space
 // (kept exactly for the patch's own corners, interpolated along the edge it
@@ -71,13 +70,6 @@ double diameter_of(const Patch& p) {
       d = std::max(
           d, glm::length(p.corners[static_cast<size_t>(i)] - p.corners[static_cast<size_t>(j)]));
   return d;
-}
-
-double signed_area(const std::vector<dvec2>& polygon) {
-  double a = 0.0;
-  for (size_t i = 0; i < polygon.size(); ++i)
-    a += cross2(polygon[i], polygon[(i + 1) % polygon.size()]);
-  return 0.5 * a;
 }
 
 std::vector<dvec2> points_of(const Polygon2& piece) {
@@ -417,10 +409,7 @@ void append_patches(const Patch& source, const Piece& piece, std::vector<Patch>&
       p.edge_inset[e] =
           (a + 1) % n == b ? insets[a] : 0.0f;  // along the piece's outline, not a diagonal
     }
-    dvec3 area_normal(0.0);
-    for (size_t i = 1; i + 1 < k; ++i)
-      area_normal += glm::cross(p.corners[i] - p.corners[0], p.corners[i + 1] - p.corners[0]);
-    p.area = 0.5 * glm::length(area_normal);
+    p.area = 0.5 * glm::length(twice_area_normal({p.corners.data(), k}));
     p.sides = piece.sides;
     if (p.area > 0.0) out.push_back(p);
   };

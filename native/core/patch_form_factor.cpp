@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "core/form_factor.h"
+#include "core/polygon.h"
 
 namespace radiosity {
 namespace {
@@ -43,10 +44,7 @@ struct Plane {
 Plane plane_of(std::span<const dvec3> polygon) {
   Plane plane;
   plane.point = polygon[0];
-  dvec3 area_normal(0.0);
-  for (size_t i = 1; i + 1 < polygon.size(); ++i) {
-    area_normal += glm::cross(polygon[i] - polygon[0], polygon[i + 1] - polygon[0]);
-  }
+  const dvec3 area_normal = twice_area_normal(polygon);
   for (size_t i = 1; i < polygon.size(); ++i) {
     plane.size = std::max(plane.size, glm::length(polygon[i] - polygon[0]));
   }

@@ -38,7 +38,8 @@ namespace radiosity {
 // cos(theta_p) cos(theta_q) / (pi r^2), counting only the parts of each polygon in
 // front of the other's plane (each polygon is clipped to the other's front
 // half-space first), no occluders. Both convex, counter-clockwise about their front
-// normals, 3 to 16 vertices (more throws std::invalid_argument). Returns 0 when
+// normals, 3 to 16 vertices (more throws std::invalid_argument), coordinates
+// within kMaxCoordinate (scene.h; beyond, products overflow). Returns 0 when
 // nothing faces, for degenerate polygons and for non-finite input. Accurate to about
 // 1e-6 relative (1e-10 typical), including contact (shared edges or vertices),
 // coplanar polygons (0) and far-apart ones. `tolerance` sets the relative error

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "core/contact.h"
+#include "core/polygon.h"
 
 namespace radiosity {
 namespace {
@@ -13,20 +14,7 @@ namespace {
 [[noreturn]] void fail(const std::string& message) { throw std::invalid_argument(message); }
 
 dvec3 polygon_area_normal(std::span<const dvec3> polygon) {
-  dvec3 sum(0.0);
-  for (size_t i = 1; i + 1 < polygon.size(); ++i) {
-    sum += glm::cross(polygon[i] - polygon[0], polygon[i + 1] - polygon[0]);
-  }
-  return 0.5 * sum;
-}
-
-double polygon_diameter(std::span<const dvec3> polygon) {
-  double d = 0.0;
-  for (size_t i = 0; i < polygon.size(); ++i) {
-    for (size_t j = i + 1; j < polygon.size(); ++j)
-      d = std::max(d, glm::length(polygon[j] - polygon[i]));
-  }
-  return d;
+  return 0.5 * twice_area_normal(polygon);
 }
 
 // Relative size below which a face counts as degenerate.
@@ -107,14 +95,12 @@ bool turns(std::span<const dvec3> polygon, double diameter) {
   return false;
 }
 
-double cross2(dvec2 a, dvec2 b, dvec2 c) {
-  return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-}
+// Which way a -> b -> c turns (positive: left).
+double turn(dvec2 a, dvec2 b, dvec2 c) { return cross2(b - a, c - a); }
 
 // Whether two edges that share no corner cross or touch, in the plane.
 bool edges_meet(dvec2 a, dvec2 b, dvec2 c, dvec2 d) {
-  const double d1 = cross2(a, b, c), d2 = cross2(a, b, d), d3 = cross2(c, d, a),
-               d4 = cross2(c, d, b);
+  const double d1 = turn(a, b, c), d2 = turn(a, b, d), d3 = turn(c, d, a), d4 = turn(c, d, b);
   const bool straddle_ab = (d1 > 0) != (d2 > 0) || d1 == 0 || d2 == 0;
   const bool straddle_cd = (d3 > 0) != (d4 > 0) || d3 == 0 || d4 == 0;
   return straddle_ab && straddle_cd && std::min(a.x, b.x) <= std::max(c.x, d.x) &&
@@ -165,12 +151,12 @@ bool triangulate(const std::vector<dvec2>& p, std::vector<std::array<size_t, 3>>
       const size_t a = remaining[(k + remaining.size() - 1) % remaining.size()];
       const size_t b = remaining[k];
       const size_t c = remaining[(k + 1) % remaining.size()];
-      if (cross2(p[a], p[b], p[c]) <= 0) continue;  // reflex corner
+      if (turn(p[a], p[b], p[c]) <= 0) continue;  // reflex corner
       bool contains = false;
       for (size_t other : remaining) {
         if (other == a || other == b || other == c) continue;
-        if (cross2(p[a], p[b], p[other]) >= 0 && cross2(p[b], p[c], p[other]) >= 0 &&
-            cross2(p[c], p[a], p[other]) >= 0) {
+        if (turn(p[a], p[b], p[other]) >= 0 && turn(p[b], p[c], p[other]) >= 0 &&
+            turn(p[c], p[a], p[other]) >= 0) {
           contains = true;
           break;
         }

@@ -5,18 +5,12 @@
 #include <cmath>
 #include <numeric>
 
+#include "core/polygon.h"
+
 namespace radiosity {
 namespace {
 
-double cross2(const dvec2& a, const dvec2& b) { return a.x * b.y - a.y * b.x; }
-
 using Polygon2 = std::vector<dvec2>;
-
-double signed_area(const Polygon2& p) {
-  double a = 0.0;
-  for (std::size_t i = 0; i < p.size(); ++i) a += cross2(p[i], p[(i + 1) % p.size()]);
-  return 0.5 * a;
-}
 
 // Convex hull of 2D points, counter-clockwise (Andrew's monotone chain).
 Polygon2 convex_hull(Polygon2 p) {

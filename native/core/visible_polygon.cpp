@@ -13,6 +13,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/polygon.h"
+
 namespace radiosity {
 namespace {
 
@@ -70,8 +72,6 @@ struct HalfPlane {
   std::int32_t line = -1;
   double distance(const dvec2& q) const { return glm::dot(w, q) + c; }
 };
-
-double cross2(const dvec2& a, const dvec2& b) { return a.x * b.y - a.y * b.x; }
 
 double signed_area(std::span<const PlaneVertex> p) {
   double a = 0.0;
@@ -263,14 +263,6 @@ EmitterFrame make_frame(std::span<const dvec3> emitter) {
   return f;
 }
 
-double diameter(std::span<const dvec3> poly) {
-  double d = 0.0;
-  for (std::size_t i = 0; i < poly.size(); ++i)
-    for (std::size_t j = i + 1; j < poly.size(); ++j)
-      d = std::max(d, glm::length(poly[i] - poly[j]));
-  return d;
-}
-
 // Clips the 3D polygon in w.space_a to m . (x - o) >= 0 (result in w.space_a).
 // Returns false if fewer than 3 vertices remain.
 bool clip_space(Workspace& w, const dvec3& m, const dvec3& o, std::int32_t boundary) {
@@ -453,7 +445,7 @@ bool setup(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter, Works
   w.r = r;
   w.n = n;
   w.frame = make_frame(emitter);
-  w.size = diameter(emitter);
+  w.size = polygon_diameter(emitter);
   w.height_r = w.frame.height(r);
   // Receiver on or behind the emitter plane sees nothing (MATH.md section 3),
   // with the rule of form_factor.cpp (receiver_in_front: above every vertex,

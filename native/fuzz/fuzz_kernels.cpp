@@ -42,8 +42,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
 
   // The solver calls it with convex patches; its contract takes anything of
-  // 3 to 16 vertices and returns 0 for what it cannot integrate.
-  if (flags & 1) {
+  // 3 to 16 vertices within kMaxCoordinate (what a Scene holds) and returns 0
+  // for what it cannot integrate.
+  const auto within = [](const std::vector<dvec3>& polygon) {
+    return std::all_of(polygon.begin(), polygon.end(),
+                       [](const dvec3& v) { return fuzz::in_range(v); });
+  };
+  if ((flags & 1) && within(p) && within(q)) {
     double f = 0.0;
     try {
       f = patch_form_factor(p, q, (flags & 2) ? 1e-6 : 1e-12);
