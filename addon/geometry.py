@@ -145,7 +145,6 @@ class SceneBuilder:
         self._occludes = []
         self._vertex_count = 0
         self.part_count = 0
-        self.part_face_start = []
 
     def add(self, positions, face_vertices, face_sizes, reflectance, emission, two_sided, occludes=True):
         """Add a part; per-face arrays have one row per face. Returns the part index.
@@ -156,7 +155,6 @@ class SceneBuilder:
         face_sizes = np.asarray(face_sizes, dtype=np.int64)
         faces = len(face_sizes)
         part = self.part_count
-        self.part_face_start.append(sum(len(s) for s in self._face_sizes))
         self._positions.append(positions)
         self._face_vertices.append(np.asarray(face_vertices, dtype=np.int64) + self._vertex_count)
         self._face_sizes.append(face_sizes)

@@ -267,7 +267,6 @@ std::int32_t Hierarchy::subdivide(std::int32_t index) {
     child.patch = parent.patch;
     child.side = parent.side;
     child.corner_count = parent.corner_count;
-    child.depth = static_cast<std::uint8_t>(parent.depth + 1);
     child.has_links = parent.has_links;
     child.area = parent.area / 4;
     child.radiance = parent.radiance;

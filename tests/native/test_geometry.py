@@ -95,7 +95,6 @@ class SceneBuilderTest(unittest.TestCase):
         np.testing.assert_array_equal(a["face_part"], [0, 1, 1])
         np.testing.assert_array_equal(a["two_sided"], [True, False, False])
         self.assertEqual(a["reflectance"].max(), 1.0)   # clipped into [0, 1]
-        self.assertEqual(b.part_face_start, [0, 1])
 
     def test_empty(self):
         a = geometry.SceneBuilder().arrays()
