@@ -26,7 +26,7 @@ struct Element {
   std::uint32_t patch = 0;
   std::uint8_t side = 0;          // 0 front, 1 back
   std::uint8_t corner_count = 0;  // 3 or 4; samples = corner_count + 1 (centre last)
-  std::uint8_t has_links = 0;  // a link ends on this element or an ancestor
+  std::uint8_t has_links = 0;     // a link ends on this element or an ancestor
   double area = 0.0;
   Rgb radiance{0.0};  // area average, L_e + rho H
 

@@ -786,8 +786,8 @@ SolveResult solve(const Scene& scene, const SolveOptions& options, const Progres
   if (options.time_budget && !(*options.time_budget > 0.0)) {
     throw std::invalid_argument("time_budget must be positive seconds");
   }
-  if (options.rays < 1 || options.rays > 65536)
-    throw std::invalid_argument("rays must lie in [1, 65536]");
+  if (options.rays < 1 || options.rays > kMaxRays)
+    throw std::invalid_argument("rays must lie in [1, " + std::to_string(kMaxRays) + "]");
   if (options.bounces && *options.bounces < 1)
     throw std::invalid_argument("bounces must be at least 1");
   if (options.threads && (*options.threads < 1 || *options.threads > kMaxThreads))

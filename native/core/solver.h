@@ -21,6 +21,8 @@ namespace radiosity {
 
 // More worker threads than any machine this runs on has cores.
 inline constexpr int kMaxThreads = 1024;
+// Shadow rays per sample point and emitter in sampled visibility: at most this.
+inline constexpr int kMaxRays = 65536;
 
 // Thrown before any work when even the unrefined solve would not fit in the
 // memory limit (Python: MemoryError, with this message).
@@ -45,7 +47,7 @@ struct SolveOptions {
   // any allocation. Default: 3/4 of the memory available when the solve starts.
   std::optional<std::size_t> memory_limit;
   VisibilityMode visibility = VisibilityMode::Exact;
-  int rays = 16;
+  int rays = 16;  // in [1, kMaxRays]
   // When set: one pass at the target threshold, with exactly this many
   // refine/gather/push-pull iterations from L = L_e (the source's 3-iteration runs).
   std::optional<int> bounces;

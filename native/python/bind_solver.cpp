@@ -280,7 +280,7 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
   }
   options.time_budget = time_budget;
   options.visibility = read_visibility(visibility);
-  options.rays = read_count(rays, "rays", 1, 65536);
+  options.rays = read_count(rays, "rays", 1, kMaxRays);
   if (!bounces.is_none()) options.bounces = read_count(bounces, "bounces", 1, INT32_MAX);
   if (!threads.is_none()) options.threads = read_count(threads, "threads", 1, kMaxThreads);
   if (!memory_limit.is_none()) {
@@ -467,7 +467,7 @@ void bind_solver(py::module_& m) {
   m.def("solve", &py_solve, py::arg("scene"), py::arg("oracle") = "perceptual",
         py::arg("quality") = 0.5, py::arg("max_elements") = py::none(),
         py::arg("time_budget") = py::none(), py::arg("visibility") = "exact",
-        py::arg("rays") = py::int_(16), py::arg("bounces") = py::none(),
+        py::arg("rays") = py::int_(SolveOptions{}.rays), py::arg("bounces") = py::none(),
         py::arg("threads") = py::none(), py::arg("progress") = py::none(),
         py::arg("cancel") = py::none(), py::arg("min_element_area") = 1e-5,
         py::arg("leaf_links") = "near", py::arg("cluster_separation") = py::none(),
