@@ -12,6 +12,17 @@
 #include "core/visible_polygon.h"
 
 namespace radiosity {
+
+std::optional<VisibilityMode> parse_visibility(std::string_view name) {
+  if (name == "exact") return VisibilityMode::Exact;
+  if (name == "sampled") return VisibilityMode::Sampled;
+  return std::nullopt;
+}
+
+std::string_view visibility_name(VisibilityMode mode) {
+  return mode == VisibilityMode::Exact ? "exact" : "sampled";
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;

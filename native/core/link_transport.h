@@ -7,7 +7,9 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
+#include <string_view>
 
 #include "core/emitter_shape.h"
 #include "core/form_factor.h"
@@ -19,6 +21,9 @@
 namespace radiosity {
 
 enum class VisibilityMode : std::uint8_t { Exact, Sampled };
+// The names the API and the add-on use: "exact", "sampled".
+std::optional<VisibilityMode> parse_visibility(std::string_view name);
+std::string_view visibility_name(VisibilityMode mode);
 
 struct Link {
   std::int32_t receiver = kNone;

@@ -768,6 +768,25 @@ std::size_t estimated_base_bytes(const Scene& scene) {
   return scene.patches.size() * kPerPatch;
 }
 
+std::optional<SolveOptions::LeafLinks> parse_leaf_links(std::string_view name) {
+  if (name == "none") return SolveOptions::LeafLinks::None;
+  if (name == "near") return SolveOptions::LeafLinks::Near;
+  if (name == "all") return SolveOptions::LeafLinks::All;
+  return std::nullopt;
+}
+
+std::string_view leaf_links_name(SolveOptions::LeafLinks links) {
+  switch (links) {
+    case SolveOptions::LeafLinks::None:
+      return "none";
+    case SolveOptions::LeafLinks::Near:
+      return "near";
+    case SolveOptions::LeafLinks::All:
+      return "all";
+  }
+  return "unknown";
+}
+
 double quality_threshold(Oracle oracle, double quality) {
   if (!(quality > 0.0)) return std::numeric_limits<double>::infinity();
   const ThresholdRange range = threshold_range(oracle);

@@ -11,6 +11,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include "core/link_transport.h"
 #include "core/oracle.h"
@@ -61,7 +62,7 @@ struct SolveOptions {
   // closer than the receiver's size), or all, with near-field links from a
   // split emitter handed to its children too (conserves energy to 1e-3, 3 to
   // 5 times more links).
-  enum class LeafLinks : std::uint8_t { None, Near, All };
+  enum class LeafLinks : std::uint8_t { None, Near, All };  // "none", "near", "all"
   LeafLinks leaf_links = LeafLinks::Near;
   // Clusters of patch sides whose centres are further apart than this many
   // times the sum of their radii exchange light through one cluster link
@@ -71,6 +72,9 @@ struct SolveOptions {
   double tolerance = 1e-6;  // relative change of radiance that counts as converged
   int max_iterations = 5000;
 };
+
+std::optional<SolveOptions::LeafLinks> parse_leaf_links(std::string_view name);
+std::string_view leaf_links_name(SolveOptions::LeafLinks links);
 
 struct SolveProgress {
   int pass = 0;

@@ -238,10 +238,12 @@ Oracle read_oracle(const std::string& name) {
   return *oracle;
 }
 
-VisibilityMode read_visibility(const std::string& name) {
-  if (name == "exact") return VisibilityMode::Exact;
-  if (name == "sampled") return VisibilityMode::Sampled;
-  throw std::invalid_argument("visibility must be 'exact' or 'sampled', got '" + name + "'");
+VisibilityMode read_visibility(const std::string& name, const char* what) {
+  const auto mode = parse_visibility(name);
+  if (!mode)
+    throw std::invalid_argument(std::string(what) + " must be 'exact' or 'sampled', got '" + name +
+                                "'");
+  return *mode;
 }
 
 // Python's integers are unbounded: a count is range-checked here, so that any
@@ -279,7 +281,7 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
         static_cast<std::size_t>(read_count(max_elements, "max_elements", 1, INT32_MAX));
   }
   options.time_budget = time_budget;
-  options.visibility = read_visibility(visibility);
+  options.visibility = read_visibility(visibility, "visibility");
   options.rays = read_count(rays, "rays", 1, kMaxRays);
   if (!bounces.is_none()) options.bounces = read_count(bounces, "bounces", 1, INT32_MAX);
   if (!threads.is_none()) options.threads = read_count(threads, "threads", 1, kMaxThreads);
@@ -296,16 +298,11 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
           "cluster_separation must be greater than 1 (or inf: no cluster links)");
     options.cluster_separation = *cluster_separation;
   }
-  if (leaf_links == "none") {
-    options.leaf_links = SolveOptions::LeafLinks::None;
-  } else if (leaf_links == "near") {
-    options.leaf_links = SolveOptions::LeafLinks::Near;
-  } else if (leaf_links == "all") {
-    options.leaf_links = SolveOptions::LeafLinks::All;
-  } else {
+  const auto links = parse_leaf_links(leaf_links);
+  if (!links)
     throw std::invalid_argument("leaf_links must be 'none', 'near' or 'all', got '" + leaf_links +
                                 "'");
-  }
+  options.leaf_links = *links;
 
   const CancelToken* token = nullptr;
   if (!cancel.is_none()) {
@@ -464,14 +461,18 @@ void bind_solver(py::module_& m) {
                     "(P, 3) float32 area-average gathered radiance H per polygon (irradiance / pi)")
       .def_readonly("stats", &PyResult::stats, "statistics of the solve (dict)");
 
-  m.def("solve", &py_solve, py::arg("scene"), py::arg("oracle") = "perceptual",
-        py::arg("quality") = 0.5, py::arg("max_elements") = py::none(),
-        py::arg("time_budget") = py::none(), py::arg("visibility") = "exact",
-        py::arg("rays") = py::int_(SolveOptions{}.rays), py::arg("bounces") = py::none(),
+  // Defaults from SolveOptions{}: defined once, in the core.
+  const SolveOptions defaults;
+  m.def("solve", &py_solve, py::arg("scene"),
+        py::arg("oracle") = std::string(oracle_name(defaults.oracle)),
+        py::arg("quality") = defaults.quality, py::arg("max_elements") = py::none(),
+        py::arg("time_budget") = py::none(),
+        py::arg("visibility") = std::string(visibility_name(defaults.visibility)),
+        py::arg("rays") = py::int_(defaults.rays), py::arg("bounces") = py::none(),
         py::arg("threads") = py::none(), py::arg("progress") = py::none(),
-        py::arg("cancel") = py::none(), py::arg("min_element_area") = 1e-5,
-        py::arg("leaf_links") = "near", py::arg("cluster_separation") = py::none(),
-        py::arg("memory_limit") = py::none(),
+        py::arg("cancel") = py::none(), py::arg("min_element_area") = defaults.min_element_area,
+        py::arg("leaf_links") = std::string(leaf_links_name(defaults.leaf_links)),
+        py::arg("cluster_separation") = py::none(), py::arg("memory_limit") = py::none(),
         "Hierarchical radiosity. oracle: 'standard' | 'perceptual' | 'gradient'; quality in\n"
         "[0, 1] (0: no refinement); max_elements, time_budget (s): budgets; visibility:\n"
         "'exact' | 'sampled' (rays per sample); bounces: fixed iteration count instead of\n"

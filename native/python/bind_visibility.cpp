@@ -8,13 +8,16 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "core/form_factor.h"
+#include "core/link_transport.h"
 #include "core/ray_scene.h"
 #include "core/sampled_visibility.h"
+#include "core/solver.h"
 #include "core/triangle.h"
 #include "core/visible_polygon.h"
 #include "python/bindings.h"
@@ -105,14 +108,16 @@ void bind_visibility(py::module_& m) {
         const std::vector<Triangle> triangles = read_triangles(occluders, "occluders");
         const std::vector<std::uint32_t> face = read_faces(faces, triangles.size());
         const std::array<std::uint32_t, 2> own = read_own_faces(own_faces);
-        if (mode != "exact" && mode != "sampled")
+        const std::optional<VisibilityMode> visibility = parse_visibility(mode);
+        if (!visibility)
           throw std::invalid_argument("mode must be 'exact' or 'sampled', got '" + mode + "'");
-        if (rays < 1 || rays > (1 << 24))
-          throw std::invalid_argument("rays must be in [1, 16777216], got " + std::to_string(rays));
+        if (rays < 1 || rays > kMaxRays)
+          throw std::invalid_argument("rays must be in [1, " + std::to_string(kMaxRays) +
+                                      "], got " + std::to_string(rays));
         FormFactorGradient result;
         {
           py::gil_scoped_release release;
-          if (mode == "exact") {
+          if (*visibility == VisibilityMode::Exact) {
             // As shaft culling does for a link: its own faces are no candidates.
             std::vector<Triangle> others;
             for (std::size_t t = 0; t < triangles.size(); ++t)
