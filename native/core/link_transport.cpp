@@ -1,7 +1,6 @@
 #include "core/link_transport.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cstdlib>
 #include <limits>
 #include <vector>
@@ -9,6 +8,7 @@
 #include "core/form_factor.h"
 #include "core/patch_form_factor.h"
 #include "core/sampled_visibility.h"
+#include "core/timing.h"
 #include "core/visible_polygon.h"
 
 namespace radiosity {
@@ -24,12 +24,6 @@ std::string_view visibility_name(VisibilityMode mode) {
 }
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // Some corner of `polygon` lies strictly in front of the plane (point, normal),
 // by more than rounding relative to the sizes involved.

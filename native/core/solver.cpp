@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -21,11 +20,10 @@
 #include "core/direct_light.h"
 #include "core/energy_balance.h"
 #include "core/gather.h"
+#include "core/timing.h"
 
 namespace radiosity {
 namespace {
-
-using Clock = std::chrono::steady_clock;
 
 // Threshold range of each oracle over quality (0, 1], log-spaced. Measured on
 // a 4 x 4 x 3 m room with a ceiling light and a box (tests/native), so that the
@@ -113,7 +111,7 @@ class Solver {
     if (!stopped_ && cancel_ && cancel_()) stopped_ = true;
     return stopped_;
   }
-  double elapsed() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+  double elapsed() const { return seconds_since(start_); }
   bool out_of_time() const { return options_.time_budget && elapsed() > *options_.time_budget; }
   // Cancelled, or a refinement cut short by the time budget: the pass is
   // abandoned and the last complete one stands.
@@ -305,7 +303,7 @@ void Solver::link_initially() {
       clusters_, hierarchy_, *occluders_.rays, cluster_separation(options_), kClusterRays,
       [this] { return cancelled() || out_of_time(); },
       [this](double done) { report("linking", 0.05 * done); });
-  stats_.seconds_clustering = std::chrono::duration<double>(Clock::now() - start).count();
+  stats_.seconds_clustering = seconds_since(start);
   // In blocks, so cancellation and progress stay prompt for large scenes.
   const size_t block = 65536;
   std::vector<Link>& candidates = initial.elements;
@@ -338,7 +336,7 @@ void Solver::link_initially() {
   links_.shrink_to_fit();
   hierarchy_.shrink_to_fit();
   ++links_version_;
-  stats_.seconds_linking = std::chrono::duration<double>(Clock::now() - start).count();
+  stats_.seconds_linking = seconds_since(start);
   track_memory();
 }
 
@@ -664,7 +662,7 @@ double Solver::iterate(double threshold, int max_iterations, double tolerance) {
     tail.before(hierarchy_);
     residual = gather_push_pull();
     const bool extrapolated = tail.after(hierarchy_, residual, refined);
-    stats_.seconds_gather += std::chrono::duration<double>(Clock::now() - start).count();
+    stats_.seconds_gather += seconds_since(start);
     ++stats_.iterations;
     stats_.residual = residual;
     if (std::isfinite(drift)) drift += residual;
