@@ -26,6 +26,7 @@ import numpy as np
 
 from radiosity import bake, export
 from test_solve import open_scene
+from scene_kit import emission_material  # noqa: E402  (scenes/ is on the path: test_solve)
 
 TMP = tempfile.mkdtemp(prefix="radiosity-user-scene-")
 
@@ -44,18 +45,6 @@ def quad(scene, name, z, size=1.0, facing_down=False, collection=None):
     obj = bpy.data.objects.new(name, mesh)
     (collection or scene.collection).objects.link(obj)
     return obj
-
-
-def emitter(name, strength):
-    mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    nodes = mat.node_tree.nodes
-    nodes.clear()
-    emission = nodes.new("ShaderNodeEmission")
-    emission.inputs["Strength"].default_value = strength
-    out = nodes.new("ShaderNodeOutputMaterial")
-    mat.node_tree.links.new(emission.outputs[0], out.inputs["Surface"])
-    return mat
 
 
 def all_finite_results(scene):
@@ -349,7 +338,7 @@ def blocker_scene(case):
         scene.world.color = (0, 0, 0)
     quad(scene, "Floor", 0.0, size=4.0)
     light = quad(scene, "Lamp", 2.0, size=0.5, facing_down=True)
-    light.data.materials.append(emitter("Lamp", 20.0))
+    light.data.materials.append(emission_material("Lamp", 20.0))
     if case is not None:
         coll = bpy.data.collections.new("Blockers")
         scene.collection.children.link(coll)
