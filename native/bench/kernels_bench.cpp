@@ -8,8 +8,8 @@
 #include <random>
 #include <vector>
 
-#include "core/form_factor.h"
-#include "core/patch_form_factor.h"
+#include "core/geometry/form_factor.h"
+#include "core/geometry/patch_form_factor.h"
 
 namespace radiosity {
 namespace {

@@ -14,11 +14,11 @@
 #include <random>
 #include <vector>
 
-#include "core/form_factor.h"
-#include "core/ray_scene.h"
-#include "core/sampled_visibility.h"
-#include "core/shaft.h"
-#include "core/visible_polygon.h"
+#include "core/geometry/form_factor.h"
+#include "core/visibility/ray_scene.h"
+#include "core/visibility/sampled_visibility.h"
+#include "core/visibility/shaft.h"
+#include "core/visibility/visible_polygon.h"
 
 namespace radiosity {
 namespace {

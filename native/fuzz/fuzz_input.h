@@ -16,10 +16,10 @@
 #include <span>
 #include <vector>
 
-#include "core/form_factor.h"
-#include "core/scene.h"
-#include "core/vec.h"
-#include "core/visible_polygon.h"
+#include "core/geometry/form_factor.h"
+#include "core/visibility/visible_polygon.h"
+#include "radiosity/scene.h"
+#include "radiosity/vec.h"
 
 namespace radiosity::fuzz {
 

@@ -11,8 +11,8 @@
 #include <cstdint>
 #include <stdexcept>
 
-#include "core/form_factor.h"
-#include "core/patch_form_factor.h"
+#include "core/geometry/form_factor.h"
+#include "core/geometry/patch_form_factor.h"
 #include "fuzz/fuzz_input.h"
 
 using namespace radiosity;

@@ -20,10 +20,10 @@
 #include <stdexcept>
 #include <vector>
 
-#include "core/lights.h"
-#include "core/scene.h"
-#include "core/solver.h"
 #include "fuzz/fuzz_input.h"
+#include "radiosity/lights.h"
+#include "radiosity/scene.h"
+#include "radiosity/solve.h"
 
 using namespace radiosity;
 

@@ -16,8 +16,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/triangle.h"
-#include "core/visible_polygon.h"
+#include "core/geometry/triangle.h"
+#include "core/visibility/visible_polygon.h"
 #include "fuzz/fuzz_input.h"
 
 using namespace radiosity;

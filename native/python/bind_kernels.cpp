@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "core/form_factor.h"
+#include "core/geometry/form_factor.h"
 #include "python/bindings.h"
 #include "python/numpy_input.h"
 

@@ -15,10 +15,10 @@
 #include <optional>
 #include <string>
 
-#include "core/scene.h"
-#include "core/solver.h"
 #include "python/bindings.h"
 #include "python/numpy_input.h"
+#include "radiosity/scene.h"
+#include "radiosity/solve.h"
 
 namespace py = pybind11;
 
@@ -186,7 +186,7 @@ py::dict stats_dict(const SolveStats& s) {
   d["skipped_faces"] = s.skipped_faces;
   d["repaired_faces"] = s.repaired_faces;
   d["cancelled"] = s.cancelled;
-  d["stopped_by"] = s.stopped_by;
+  d["stopped_by"] = std::string(stop_reason_name(s.stopped_by));
   d["seconds"] = s.seconds;
   d["seconds_linking"] = s.seconds_linking;
   d["seconds_clustering"] = s.seconds_clustering;
@@ -325,7 +325,7 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
         py::dict d;
         d["pass"] = p.pass;
         d["passes"] = p.passes;
-        d["phase"] = p.phase;
+        d["phase"] = std::string(phase_name(p.phase));
         d["elements"] = p.elements;
         d["links"] = p.links;
         d["threshold"] = p.threshold;
@@ -354,6 +354,8 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
 
 void bind_solver(py::module_& m) {
   py::register_exception<InsufficientMemory>(m, "InsufficientMemoryError", PyExc_MemoryError);
+  // The options' defaults and limits by name (the add-on's solver_defaults.json holds the same).
+  m.attr("DEFAULTS") = py::module_::import("json").attr("loads")(defaults_json());
   py::class_<CancelToken>(
       m, "CancelToken",
       "A flag another thread can set to stop a solve; the solve then returns the "

@@ -13,15 +13,15 @@
 #include <string>
 #include <vector>
 
-#include "core/form_factor.h"
-#include "core/link_transport.h"
-#include "core/ray_scene.h"
-#include "core/sampled_visibility.h"
-#include "core/solver.h"
-#include "core/triangle.h"
-#include "core/visible_polygon.h"
+#include "core/geometry/form_factor.h"
+#include "core/geometry/triangle.h"
+#include "core/solve/link_transport.h"
+#include "core/visibility/ray_scene.h"
+#include "core/visibility/sampled_visibility.h"
+#include "core/visibility/visible_polygon.h"
 #include "python/bindings.h"
 #include "python/numpy_input.h"
+#include "radiosity/solve.h"
 
 namespace py = pybind11;
 

@@ -4,8 +4,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "core/polygon.h"
-#include "core/scene.h"
+#include "core/geometry/polygon.h"
+#include "radiosity/scene.h"
 
 namespace py = pybind11;
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "core/vec.h"
+#include "radiosity/vec.h"
 
 namespace radiosity::python {
 

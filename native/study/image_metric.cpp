@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "core/color.h"
+#include "radiosity/color.h"
 
 namespace radiosity {
 namespace {

@@ -51,8 +51,8 @@
 #include <string>
 #include <vector>
 
-#include "core/form_factor.h"
-#include "core/visible_polygon.h"
+#include "core/geometry/form_factor.h"
+#include "core/visibility/visible_polygon.h"
 
 namespace radiosity {
 namespace {

@@ -1,0 +1,43 @@
+// The measures of one polygon that the scene's checks, the kernels and contact
+// meshing all take: one definition each.
+#pragma once
+
+#include <algorithm>
+#include <span>
+
+#include "radiosity/vec.h"
+
+namespace radiosity {
+
+// The z of the 3D cross product of two vectors in a plane.
+inline double cross2(const dvec2& a, const dvec2& b) { return a.x * b.y - a.y * b.x; }
+
+// Area of a plane polygon, positive when counter-clockwise.
+inline double signed_area(std::span<const dvec2> polygon) {
+  double a = 0.0;
+  for (std::size_t i = 0, k = polygon.size(); i < k; ++i)
+    a += cross2(polygon[i], polygon[(i + 1) % k]);
+  return 0.5 * a;
+}
+
+// Twice the area vector: the fan of cross products about corner 0, whose
+// length is twice the area and whose direction is the front normal of
+// counter-clockwise corners. Taken relative to corner 0, so a small polygon
+// far from the origin keeps its digits.
+inline dvec3 twice_area_normal(std::span<const dvec3> polygon) {
+  dvec3 sum(0.0);
+  for (std::size_t i = 1; i + 1 < polygon.size(); ++i)
+    sum += glm::cross(polygon[i] - polygon[0], polygon[i + 1] - polygon[0]);
+  return sum;
+}
+
+// The largest distance between two corners.
+inline double polygon_diameter(std::span<const dvec3> polygon) {
+  double d = 0.0;
+  for (std::size_t i = 0; i < polygon.size(); ++i)
+    for (std::size_t j = i + 1; j < polygon.size(); ++j)
+      d = std::max(d, glm::length(polygon[j] - polygon[i]));
+  return d;
+}
+
+}  // namespace radiosity

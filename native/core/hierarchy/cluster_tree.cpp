@@ -1,0 +1,138 @@
+#include "core/hierarchy/cluster_tree.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace radiosity {
+namespace {
+
+// Which of the six axis directions the normal is closest to.
+int facing_class(const dvec3& n) {
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::abs(n[k]) > std::abs(n[axis])) axis = k;
+  return 2 * axis + (n[axis] < 0.0 ? 1 : 0);
+}
+
+}  // namespace
+
+ClusterTree::ClusterTree(const Hierarchy& hierarchy) {
+  for (std::uint32_t p = 0; p < hierarchy.scene().patches.size(); ++p) {
+    for (int side = 0; side < 2; ++side) {
+      const std::int32_t root = hierarchy.root(p, side);
+      if (root == kNone) continue;
+      const Element& e = hierarchy.element(root);
+      if (luminance(hierarchy.reflectance(e)) > 0.0 || luminance(hierarchy.emission(e)) > 0.0)
+        sides_.push_back(root);
+    }
+  }
+  if (sides_.empty()) return;
+  nodes_.reserve(2 * sides_.size());
+  build(hierarchy, 0, static_cast<std::uint32_t>(sides_.size()));
+  area_prefix_.assign(sides_.size() + 1, 0.0);
+  for (size_t i = 0; i < sides_.size(); ++i)
+    area_prefix_[i + 1] = area_prefix_[i] + hierarchy.element(sides_[i]).area;
+}
+
+std::int32_t ClusterTree::build(const Hierarchy& hierarchy, std::uint32_t first,
+                                std::uint32_t count) {
+  const auto index = static_cast<std::int32_t>(nodes_.size());
+  nodes_.emplace_back();
+  const auto begin = sides_.begin() + first, end = begin + count;
+
+  ClusterNode node;
+  node.first = first;
+  node.count = count;
+  dvec3 lo(std::numeric_limits<double>::infinity()), hi = -lo;
+  dvec3 weighted_normal(0.0);
+  for (auto it = begin; it != end; ++it) {
+    const Element& e = hierarchy.element(*it);
+    dvec3 corners[4];
+    const int n = hierarchy.corners(e, corners);
+    for (int k = 0; k < n; ++k) {
+      lo = glm::min(lo, corners[k]);
+      hi = glm::max(hi, corners[k]);
+    }
+    weighted_normal += e.area * hierarchy.normal(e);
+    node.centre += e.area * hierarchy.centre(e);
+    node.area += e.area;
+    node.reflects |= luminance(hierarchy.reflectance(e)) > 0.0;
+    node.sends |=
+        luminance(hierarchy.reflectance(e)) > 0.0 || luminance(hierarchy.emission(e)) > 0.0;
+    node.emits |= luminance(hierarchy.emission(e)) > 0.0;
+  }
+  node.centre = node.area > 0.0 ? node.centre / node.area : 0.5 * (lo + hi);
+  for (auto it = begin; it != end; ++it) {
+    dvec3 corners[4];
+    const int n = hierarchy.corners(hierarchy.element(*it), corners);
+    for (int k = 0; k < n; ++k)
+      node.radius = std::max(node.radius, glm::length(corners[k] - node.centre));
+  }
+  const double length = glm::length(weighted_normal);
+  node.axis = length > 0.0 ? weighted_normal / length : hierarchy.normal(hierarchy.element(*begin));
+  for (auto it = begin; it != end; ++it) {
+    const double c =
+        std::clamp(glm::dot(node.axis, hierarchy.normal(hierarchy.element(*it))), -1.0, 1.0);
+    node.spread = std::max(node.spread, std::acos(c));
+  }
+  node.height_lo = std::numeric_limits<double>::infinity();
+  node.height_hi = -node.height_lo;
+  for (auto it = begin; it != end; ++it) {
+    dvec3 corners[4];
+    const int n = hierarchy.corners(hierarchy.element(*it), corners);
+    for (int k = 0; k < n; ++k) {
+      node.height_lo = std::min(node.height_lo, glm::dot(node.axis, corners[k]));
+      node.height_hi = std::max(node.height_hi, glm::dot(node.axis, corners[k]));
+    }
+  }
+
+  if (count > 1) {
+    // Facing classes first (sides in one class face within 55 degrees of an
+    // axis), then halves along the longest extent of the centres.
+    const auto class_of = [&](std::int32_t e) {
+      return facing_class(hierarchy.normal(hierarchy.element(e)));
+    };
+    const auto centre_of = [&](std::int32_t e) { return hierarchy.centre(hierarchy.element(e)); };
+    std::stable_sort(begin, end,
+                     [&](std::int32_t a, std::int32_t b) { return class_of(a) < class_of(b); });
+    std::uint32_t half = 0;
+    if (class_of(*begin) != class_of(*(end - 1))) {
+      // The class boundary nearest the middle.
+      std::uint32_t best = count;
+      for (std::uint32_t i = 1; i < count; ++i) {
+        if (class_of(*(begin + i)) == class_of(*(begin + i - 1))) continue;
+        const auto distance = [&](std::uint32_t k) {
+          return k > count / 2 ? k - count / 2 : count / 2 - k;
+        };
+        if (best == count || distance(i) < distance(best)) best = i;
+      }
+      half = best;
+    } else {
+      dvec3 low(std::numeric_limits<double>::infinity()), high = -low;
+      for (auto it = begin; it != end; ++it)
+        low = glm::min(low, centre_of(*it)), high = glm::max(high, centre_of(*it));
+      const dvec3 extent = high - low;
+      const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0
+                       : extent.y >= extent.z                       ? 1
+                                                                    : 2;
+      half = count / 2;
+      // Ties broken by element id: the tree does not depend on the sort's luck.
+      std::nth_element(begin, begin + half, end, [&](std::int32_t a, std::int32_t b) {
+        const double ca = centre_of(a)[axis], cb = centre_of(b)[axis];
+        return ca < cb || (ca == cb && a < b);
+      });
+    }
+    node.child[0] = build(hierarchy, first, half);
+    node.child[1] = build(hierarchy, first + half, count - half);
+  }
+  nodes_[static_cast<size_t>(index)] = node;
+  return index;
+}
+
+std::size_t ClusterTree::memory_bytes() const {
+  return nodes_.capacity() * sizeof(ClusterNode) + sides_.capacity() * sizeof(std::int32_t) +
+         area_prefix_.capacity() * sizeof(double);
+}
+
+}  // namespace radiosity

@@ -1,0 +1,190 @@
+#include "core/solve/refine.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+
+namespace radiosity {
+namespace {
+
+// Emitted power over area divided by the mean radiance of the lit sides, in
+// the calibration room (solver.cpp, threshold_range), measured: keeps its refinement.
+constexpr double kAdaptationCalibration = 0.52;
+
+// Light a light link's samples miss (LightLink::missed) is refined for when it
+// would reach this fraction of the radiance the eye adapts to.
+constexpr double kMissedLight = 0.01;
+
+}  // namespace
+
+// The brightness an eye adapts to, which thresholds are relative to. With
+// the emitted power over the area instead, a white room (whose mean radiance
+// is 1 / (1 - rho) times larger) refined as if seen ten to a hundred times
+// brighter: 5.5 million links at rho = 0.9. Scaled by kAdaptationCalibration
+// so that the test room the thresholds were calibrated on refines as before.
+double adaptation_radiance(const Hierarchy& hierarchy) {
+  double light = 0.0, area = 0.0;
+  for (size_t r = 0; r < hierarchy.root_count(); ++r) {
+    const std::int32_t root =
+        hierarchy.root(static_cast<std::uint32_t>(r / 2), static_cast<int>(r % 2));
+    if (root == kNone) continue;
+    const Element& e = hierarchy.element(root);
+    if (!e.has_links && !(luminance(hierarchy.emission(e)) > 0.0)) continue;
+    light += e.area * luminance(e.radiance);
+    area += e.area;
+  }
+  const double mean = area > 0.0 ? light / area : 0.0;
+  return mean > 0.0 ? kAdaptationCalibration * mean : hierarchy.scene().reference_radiance();
+}
+
+// Then the form factor varies over that end in ways five samples (receiver)
+// or a split in four (emitter shape) cannot follow: it grows quickly towards
+// a shared edge. Such links follow a split end down instead.
+bool near_field(const Hierarchy& hierarchy, const Link& link, bool receiver_end) {
+  const Element& p = hierarchy.element(link.receiver);
+  const Element& q = hierarchy.element(link.emitter);
+  const double rp = 0.5 * hierarchy.diameter(p), rq = 0.5 * hierarchy.diameter(q);
+  const double gap = glm::length(hierarchy.centre(p) - hierarchy.centre(q)) - rp - rq;
+  return gap < 2.0 * (receiver_end ? rp : rq);
+}
+
+// Split the larger of receiver and emitter unless it is at the minimum size,
+// then the other.
+Split choose_split(const Hierarchy& hierarchy, const Link& link, double threshold,
+                   double reference_radiance, const RefineLimits& limits) {
+  const Element& p = hierarchy.element(link.receiver);
+  const Element& q = hierarchy.element(link.emitter);
+  const double brightness = luminance(hierarchy.reflectance(p) * q.radiance);
+  if (!(brightness / reference_radiance * link.oracle > threshold)) return Split::None;
+  const bool receiver_first = p.area >= q.area;
+  const std::int32_t first = receiver_first ? link.receiver : link.emitter;
+  const std::int32_t second = receiver_first ? link.emitter : link.receiver;
+  if (limits.can_split(hierarchy, first)) return receiver_first ? Split::Receiver : Split::Emitter;
+  if (limits.can_split(hierarchy, second)) return receiver_first ? Split::Emitter : Split::Receiver;
+  return Split::None;
+}
+
+std::vector<Split> choose_splits(const Hierarchy& hierarchy, std::span<const Link> links,
+                                 double threshold, double reference_radiance,
+                                 const RefineLimits& limits) {
+  std::vector<Split> decision(links.size(), Split::None);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, links.size()), [&](const auto& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i)
+      decision[i] = choose_split(hierarchy, links[i], threshold, reference_radiance, limits);
+  });
+  return decision;
+}
+
+SplitLinks split_links(Hierarchy& hierarchy, std::span<const Link> links,
+                       std::span<const Split> decision, const RefineLimits& limits) {
+  SplitLinks out;
+  for (size_t i = 0; i < links.size(); ++i) {
+    const Link& link = links[i];
+    if (decision[i] != Split::None) {
+      const std::int32_t target = decision[i] == Split::Receiver ? link.receiver : link.emitter;
+      const bool split_already = !hierarchy.element(target).is_leaf();
+      if (!split_already && limits.budget_full(hierarchy)) {
+        out.budget_hit = true;
+      } else {
+        const std::int32_t child = hierarchy.subdivide(target);
+        for (std::int32_t c = child; c < child + 4; ++c) {
+          Link l;
+          l.receiver = decision[i] == Split::Receiver ? c : link.receiver;
+          l.emitter = decision[i] == Split::Emitter ? c : link.emitter;
+          out.fresh.push_back(l);
+        }
+        continue;
+      }
+    }
+    out.kept.push_back(link);
+  }
+  return out;
+}
+
+// "near": near-field links of a split receiver; "all": all of them, and
+// near-field links from a split emitter to its children too, so that they
+// send what each part of the emitter reflects.
+void hand_down_links(const Hierarchy& hierarchy, SolveOptions::LeafLinks leaf_links,
+                     SplitLinks& links) {
+  if (leaf_links == SolveOptions::LeafLinks::None) return;
+  const bool all = leaf_links == SolveOptions::LeafLinks::All;
+  const auto hand_down = [&](const std::vector<Link>& from, std::vector<Link>& staying,
+                             std::vector<Link>& moved) {
+    for (const Link& link : from) {
+      const Element& receiver = hierarchy.element(link.receiver);
+      const Element& emitter = hierarchy.element(link.emitter);
+      const bool receiver_down = !receiver.is_leaf() && (all || near_field(hierarchy, link, true));
+      const bool emitter_down =
+          !receiver_down && all && !emitter.is_leaf() && near_field(hierarchy, link, false);
+      if (!receiver_down && !emitter_down) {
+        staying.push_back(link);
+        continue;
+      }
+      const std::int32_t first = receiver_down ? receiver.first_child : emitter.first_child;
+      for (std::int32_t c = first; c < first + 4; ++c) {
+        Link l;
+        l.receiver = receiver_down ? c : link.receiver;
+        l.emitter = receiver_down ? link.emitter : c;
+        moved.push_back(l);
+      }
+    }
+  };
+  std::vector<Link> staying, fresh;
+  hand_down(links.kept, staying, links.fresh);
+  // A fresh link handed down stays fresh: its children go to the same list.
+  hand_down(links.fresh, fresh, fresh);
+  links.kept = std::move(staying);
+  links.fresh = std::move(fresh);
+}
+
+// Light links take part in refinement like links whose emitter cannot be
+// split: one above the threshold splits its receiver.
+bool split_light_receivers(Hierarchy& hierarchy, std::span<const Light> lights,
+                           std::span<const LightLink> links, double threshold,
+                           double reference_radiance, const RefineLimits& limits) {
+  std::vector<std::uint8_t> split(links.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, links.size()), [&](const auto& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      const LightLink& l = links[i];
+      const Element& p = hierarchy.element(l.receiver);
+      const double brightness = luminance(hierarchy.reflectance(p) * lights[l.light].colour);
+      // Light the samples miss splits the receiver when it would show (a
+      // hundredth of the adaptation level) whatever the oracle: the oracle
+      // can only judge what the samples see.
+      const bool missed = brightness * l.missed > kMissedLight * reference_radiance;
+      split[i] = p.is_leaf() &&
+                 (missed || brightness / reference_radiance * l.oracle > threshold) &&
+                 limits.can_split(hierarchy, l.receiver);
+    }
+  });
+  for (size_t i = 0; i < links.size(); ++i) {
+    if (!split[i] || !hierarchy.element(links[i].receiver).is_leaf()) continue;
+    if (limits.budget_full(hierarchy)) return true;
+    hierarchy.subdivide(links[i].receiver);
+  }
+  return false;
+}
+
+// Direct light is always evaluated at the leaves that gather it.
+std::vector<LightLink> hand_down_light_links(const Hierarchy& hierarchy,
+                                             std::vector<LightLink>& links) {
+  std::vector<LightLink> kept, fresh;
+  for (const LightLink& l : links) {
+    const Element& p = hierarchy.element(l.receiver);
+    if (p.is_leaf()) {
+      kept.push_back(l);
+      continue;
+    }
+    for (std::int32_t c = p.first_child; c < p.first_child + 4; ++c) {
+      LightLink child;
+      child.receiver = c;
+      child.light = l.light;
+      fresh.push_back(child);
+    }
+  }
+  links = std::move(kept);
+  return fresh;
+}
+
+}  // namespace radiosity

@@ -1,0 +1,120 @@
+// The names of the solver's enums at the boundary (radiosity/solve.h): each
+// table is written once here, and the bindings parse and print through it.
+// Also the defaults as JSON, for the add-on's settings.
+#include <charconv>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <string_view>
+
+#include "radiosity/solve.h"
+
+namespace radiosity {
+
+std::optional<Oracle> parse_oracle(std::string_view name) {
+  if (name == "standard") return Oracle::Standard;
+  if (name == "perceptual") return Oracle::Perceptual;
+  if (name == "gradient") return Oracle::Gradient;
+  return std::nullopt;
+}
+
+std::string_view oracle_name(Oracle oracle) {
+  switch (oracle) {
+    case Oracle::Standard:
+      return "standard";
+    case Oracle::Perceptual:
+      return "perceptual";
+    case Oracle::Gradient:
+      return "gradient";
+  }
+  return "unknown";
+}
+
+std::optional<VisibilityMode> parse_visibility(std::string_view name) {
+  if (name == "exact") return VisibilityMode::Exact;
+  if (name == "sampled") return VisibilityMode::Sampled;
+  return std::nullopt;
+}
+
+std::string_view visibility_name(VisibilityMode mode) {
+  return mode == VisibilityMode::Exact ? "exact" : "sampled";
+}
+
+std::optional<SolveOptions::LeafLinks> parse_leaf_links(std::string_view name) {
+  if (name == "none") return SolveOptions::LeafLinks::None;
+  if (name == "near") return SolveOptions::LeafLinks::Near;
+  if (name == "all") return SolveOptions::LeafLinks::All;
+  return std::nullopt;
+}
+
+std::string_view leaf_links_name(SolveOptions::LeafLinks links) {
+  switch (links) {
+    case SolveOptions::LeafLinks::None:
+      return "none";
+    case SolveOptions::LeafLinks::Near:
+      return "near";
+    case SolveOptions::LeafLinks::All:
+      return "all";
+  }
+  return "unknown";
+}
+
+std::string_view phase_name(SolvePhase phase) {
+  switch (phase) {
+    case SolvePhase::Linking:
+      return "linking";
+    case SolvePhase::Refining:
+      return "refining";
+    case SolvePhase::Pass:
+      return "pass";
+    case SolvePhase::Done:
+      return "done";
+  }
+  return "unknown";
+}
+
+std::string_view stop_reason_name(StopReason reason) {
+  switch (reason) {
+    case StopReason::Quality:
+      return "quality";
+    case StopReason::MaxElements:
+      return "max_elements";
+    case StopReason::Memory:
+      return "memory";
+    case StopReason::TimeBudget:
+      return "time_budget";
+    case StopReason::Cancel:
+      return "cancel";
+  }
+  return "unknown";
+}
+
+namespace {
+
+// The shortest text that reads back as the same double.
+std::string number(double x) {
+  char text[32];
+  const auto end = std::to_chars(text, text + sizeof text, x).ptr;
+  return std::string(text, end);
+}
+
+}  // namespace
+
+std::string defaults_json() {
+  const SolveOptions d{};
+  std::ostringstream out;
+  out << "{\n"
+      << "  \"oracle\": \"" << oracle_name(d.oracle) << "\",\n"
+      << "  \"quality\": " << number(d.quality) << ",\n"
+      << "  \"visibility\": \"" << visibility_name(d.visibility) << "\",\n"
+      << "  \"rays\": " << d.rays << ",\n"
+      << "  \"max_rays\": " << kMaxRays << ",\n"
+      << "  \"min_element_area\": " << number(d.min_element_area) << ",\n"
+      << "  \"leaf_links\": \"" << leaf_links_name(d.leaf_links) << "\",\n"
+      << "  \"tolerance\": " << number(d.tolerance) << ",\n"
+      << "  \"max_iterations\": " << d.max_iterations << "\n"
+      << "}\n";
+  return out.str();
+}
+
+}  // namespace radiosity

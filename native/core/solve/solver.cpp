@@ -1,0 +1,580 @@
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/hierarchy/cluster_tree.h"
+#include "core/hierarchy/make_output_mesh.h"
+#include "core/solve/cluster_links.h"
+#include "core/solve/convergence.h"
+#include "core/solve/direct_light.h"
+#include "core/solve/energy_balance.h"
+#include "core/solve/gather.h"
+#include "core/solve/link_batch.h"
+#include "core/solve/refine.h"
+#include "core/solve/timing.h"
+#include "radiosity/solve.h"
+
+namespace radiosity {
+namespace {
+
+// Threshold range of each oracle over quality (0, 1], log-spaced. Measured on
+// a 4 x 4 x 3 m room with a ceiling light and a box (tests/native), so that the
+// three oracles make similar element counts at the same quality (about 4,000 at
+// 0.5) and 0.1 barely refines; see bench/ for the sweeps.
+struct ThresholdRange {
+  double coarse, fine;
+};
+
+ThresholdRange threshold_range(Oracle oracle) {
+  switch (oracle) {
+    case Oracle::Standard:
+      return {1e-2, 1e-7};
+    case Oracle::Perceptual:
+      return {1.0, 4e-3};
+    case Oracle::Gradient:
+      return {1e-1, 2.5e-4};
+  }
+  return {1.0, 1e-4};
+}
+
+// Far enough apart for a cluster link: the emitter cluster's light is taken
+// as if it left from its centroid, which errs more the larger it looks from
+// the receiver, so finer quality asks for more distance.
+double cluster_separation(const SolveOptions& options) {
+  return options.cluster_separation > 0.0 ? options.cluster_separation
+                                          : 2.0 + 8.0 * options.quality;
+}
+
+// Shadow rays that measure a cluster link's visible fraction.
+constexpr int kClusterRays = 16;
+
+// Bytes of memory available now (Linux: MemAvailable), or a large number
+// where it cannot be read.
+std::size_t available_memory() {
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  std::size_t kilobytes = 0;
+  std::string unit;
+  while (meminfo >> key >> kilobytes >> unit) {
+    if (key == "MemAvailable:") return kilobytes * 1024;
+  }
+  const long pages = sysconf(_SC_AVPHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  if (pages > 0 && page > 0)
+    return static_cast<std::size_t>(pages) * static_cast<std::size_t>(page);
+  return std::numeric_limits<std::size_t>::max() / 2;
+}
+
+double gigabytes(std::size_t bytes) { return std::round(static_cast<double>(bytes) / 1e8) / 10.0; }
+
+class Solver {
+ public:
+  Solver(const Scene& scene, const SolveOptions& options, const ProgressCallback& progress,
+         const CancelCheck& cancel)
+      : scene_(scene),
+        options_(options),
+        progress_(progress),
+        cancel_(cancel),
+        start_(Clock::now()),
+        hierarchy_(scene),
+        occluders_(make_scene_occluders(scene)),
+        evaluator_{hierarchy_,         occluders_,
+                   options.visibility, options.rays,
+                   options.oracle,     oracle_geometric_scale(options.oracle, scene.total_area)},
+        direct_(hierarchy_, occluders_, options.visibility, options.rays, options.oracle,
+                oracle_geometric_scale(options.oracle, scene.total_area)),
+        limits_{options.min_element_area * scene.total_area, options.max_elements},
+        memory_limit_(options.memory_limit.value_or(std::numeric_limits<std::size_t>::max())),
+        clusters_(hierarchy_) {}
+
+  SolveResult run();
+
+ private:
+  bool cancelled() const {
+    if (!stopped_ && cancel_ && cancel_()) stopped_ = true;
+    return stopped_;
+  }
+  double elapsed() const { return seconds_since(start_); }
+  bool out_of_time() const { return options_.time_budget && elapsed() > *options_.time_budget; }
+  // Cancelled, or a refinement cut short by the time budget: the pass is
+  // abandoned and the last complete one stands.
+  bool pass_abandoned() const { return cancelled() || refinement_cut_short_; }
+
+  void report(SolvePhase phase, double fraction);
+  void link_initially();
+  void drop_links_light_cannot_reach();
+  std::vector<Link> evaluate(std::vector<Link>&& candidates);
+  bool refine(double threshold);
+  bool refine_light_links(double threshold);
+  void gather_direct_light();
+  bool over_memory() const { return stats_.element_bytes + stats_.link_bytes > memory_limit_; }
+  void group_links();
+  void gather_far_light();
+  double gather_push_pull();
+  double iterate(double threshold, int max_iterations, double tolerance);
+  void snapshot(double threshold);
+  void track_memory();
+
+  const Scene& scene_;
+  const SolveOptions options_;
+  const ProgressCallback& progress_;
+  const CancelCheck& cancel_;
+  mutable std::atomic<bool> stopped_{false};  // read and set from worker threads
+  const Clock::time_point start_;
+  Hierarchy hierarchy_;
+  SceneOccluders occluders_;
+  LinkEvaluator evaluator_;
+  DirectLight direct_;
+  // Brightness the oracles' thresholds are relative to (refine()).
+  double reference_radiance_ = 0.0;
+  const RefineLimits limits_;
+  const std::size_t memory_limit_;  // bytes of elements and links (SolveOptions::memory_limit)
+  std::vector<Link> links_;
+  // Links grouped by receiver for the gather, and which links they describe.
+  std::vector<std::uint32_t> offset_, order_;
+  std::vector<Rgb> source_;  // radiance per element as the last gather read it (what each sends)
+  EnergyBalance balance_;    // corrections of what is received and sent (energy_balance.h)
+  ClusterTree clusters_;
+  std::vector<ClusterLink> cluster_links_;
+  ClusterGather cluster_gather_;
+  std::vector<Rgb> far_light_;  // what each top-level element gathers through cluster links
+  // Light from the lights that are not surfaces: one link per leaf and light
+  // that reaches it, and what each element gathers from them at its samples.
+  std::vector<LightLink> light_links_;
+  std::vector<SampleRgb> direct_light_;
+  std::uint64_t light_version_ = 1, direct_version_ = 0;
+  std::uint64_t links_version_ = 1, grouped_version_ = 0;
+  SolveResult result_;       // the last complete pass
+  bool budget_hit_ = false;  // max_elements or memory_limit reached
+  bool memory_hit_ = false;
+  bool cut_short_ = false;             // the last evaluate_links stopped before the end
+  bool refinement_cut_short_ = false;  // ... within refine(): the pass is abandoned
+  int pass_ = 0, passes_ = 1;
+  double threshold_ = std::numeric_limits<double>::infinity();
+  SolveStats stats_;
+};
+
+void Solver::report(SolvePhase phase, double fraction) {
+  if (!progress_) return;
+  SolveProgress p;
+  p.pass = pass_;
+  p.passes = passes_;
+  p.phase = phase;
+  p.elements = hierarchy_.elements().size();
+  p.links = links_.size();
+  p.threshold = threshold_;
+  p.seconds = elapsed();
+  p.fraction = std::clamp(fraction, 0.0, 1.0);
+  progress_(p);
+}
+
+// Elements: the hierarchy (elements, vertices, midpoints) and the per-element
+// gather tables; links: the links and their receiver grouping.
+void Solver::track_memory() {
+  stats_.element_bytes = hierarchy_.memory_bytes() + offset_.capacity() * sizeof(std::uint32_t) +
+                         source_.capacity() * sizeof(Rgb) + clusters_.memory_bytes() +
+                         cluster_gather_.memory_bytes() + far_light_.capacity() * sizeof(Rgb) +
+                         balance_.memory_bytes() + direct_light_.capacity() * sizeof(SampleRgb);
+  stats_.link_bytes = links_.capacity() * sizeof(Link) + order_.capacity() * sizeof(std::uint32_t) +
+                      cluster_links_.capacity() * sizeof(ClusterLink) +
+                      light_links_.capacity() * sizeof(LightLink);
+  stats_.peak_bytes = std::max(stats_.peak_bytes, stats_.element_bytes + stats_.link_bytes);
+}
+
+// Evaluates links (link_batch.h) until cancelled or out of time, keeping the
+// peak of memory they take in the statistics.
+std::vector<Link> Solver::evaluate(std::vector<Link>&& candidates) {
+  std::vector<Link> made = evaluate_links(
+      evaluator_, hierarchy_, std::move(candidates),
+      [this] { return cancelled() || out_of_time(); }, stats_.link_cpu, cut_short_);
+  stats_.peak_bytes =
+      std::max(stats_.peak_bytes, hierarchy_.memory_bytes() + links_.capacity() * sizeof(Link) +
+                                      made.capacity() * sizeof(Link));
+  return made;
+}
+
+// Links between the top-level patch sides that can exchange light (the
+// receiver reflects, the emitter emits or reflects): clusters far apart that
+// face each other get one cluster link, pairs facing away are dropped whole,
+// before any visibility work; the remaining pairs of sides are evaluated as
+// ordinary links (cluster_links.h).
+void Solver::link_initially() {
+  const auto start = Clock::now();
+  // Progress: the walk is the first half of linking, evaluating face links the second.
+  InitialLinks initial = link_clusters(
+      clusters_, hierarchy_, *occluders_.rays, cluster_separation(options_), kClusterRays,
+      [this] { return cancelled() || out_of_time(); },
+      [this](double done) { report(SolvePhase::Linking, 0.05 * done); });
+  stats_.seconds_clustering = seconds_since(start);
+  // In blocks, so cancellation and progress stay prompt for large scenes.
+  const size_t block = 65536;
+  std::vector<Link>& candidates = initial.elements;
+  for (size_t begin = 0; begin < candidates.size() && !cancelled() && !out_of_time();
+       begin += block) {
+    const size_t end = std::min(candidates.size(), begin + block);
+    std::vector<Link> visible =
+        evaluate(std::vector<Link>(candidates.begin() + static_cast<std::ptrdiff_t>(begin),
+                                   candidates.begin() + static_cast<std::ptrdiff_t>(end)));
+    links_.insert(links_.end(), visible.begin(), visible.end());
+    report(SolvePhase::Linking,
+           0.05 + 0.05 * static_cast<double>(end) / static_cast<double>(candidates.size()));
+  }
+  candidates = {};
+  cluster_links_ = std::move(initial.clusters);
+  cluster_links_.shrink_to_fit();
+  if (!scene_.lights.empty() && !cancelled()) {
+    light_links_ = evaluate_light_links(direct_, direct_.initial_links());
+    ++light_version_;
+  }
+  drop_links_light_cannot_reach();
+  for (const ClusterLink& l : cluster_links_) {
+    const ClusterNode& node = clusters_.node(l.receiver);
+    for (std::uint32_t i = node.first; i < node.first + node.count; ++i)
+      hierarchy_.element(clusters_.sides()[i]).has_links = 1;
+  }
+  if (cluster_links_.empty()) clusters_.release();
+  for (const Link& l : links_) hierarchy_.element(l.receiver).has_links = 1;
+  for (const LightLink& l : light_links_) hierarchy_.element(l.receiver).has_links = 1;
+  links_.shrink_to_fit();
+  hierarchy_.shrink_to_fit();
+  ++links_version_;
+  stats_.seconds_linking = seconds_since(start);
+  track_memory();
+}
+
+// A side that no light can reach (the inside of a closed box, the floor
+// under it) keeps no links: it would never carry any light, yet its links
+// would be gathered, its elements shown (doubling the box in the output) and
+// its leaks of rounding taken for light. Light starts at the emitting sides
+// and the receivers of light links and spreads through the links, from
+// emitter to receiver; cluster links count as reaching every side of their
+// receiving cluster.
+void Solver::drop_links_light_cannot_reach() {
+  const size_t sides = hierarchy_.root_count();
+  std::vector<std::uint8_t> reached(hierarchy_.elements().size(), 0);
+  for (size_t r = 0; r < sides; ++r) {
+    const std::int32_t root =
+        hierarchy_.root(static_cast<std::uint32_t>(r / 2), static_cast<int>(r % 2));
+    if (root != kNone && luminance(hierarchy_.emission(hierarchy_.element(root))) > 0.0)
+      reached[static_cast<size_t>(root)] = 1;
+  }
+  for (const LightLink& l : light_links_) reached[static_cast<size_t>(l.receiver)] = 1;
+  for (const ClusterLink& l : cluster_links_) {
+    const ClusterNode& node = clusters_.node(l.receiver);
+    for (std::uint32_t i = node.first; i < node.first + node.count; ++i)
+      reached[static_cast<size_t>(clusters_.sides()[i])] = 1;
+  }
+  for (bool spread = true; spread;) {
+    spread = false;
+    for (const Link& l : links_) {
+      if (reached[static_cast<size_t>(l.emitter)] && !reached[static_cast<size_t>(l.receiver)]) {
+        reached[static_cast<size_t>(l.receiver)] = 1;
+        spread = true;
+      }
+    }
+  }
+  std::erase_if(links_, [&](const Link& l) { return !reached[static_cast<size_t>(l.receiver)]; });
+}
+
+// Refines every link above the threshold (refine.h), repeatedly, until none
+// is, evaluating the new links. Returns whether anything changed.
+bool Solver::refine(double threshold) {
+  if (!std::isfinite(threshold)) return false;
+  reference_radiance_ = adaptation_radiance(hierarchy_);
+  bool changed = false;
+  while (!cancelled() && !budget_hit_ && !out_of_time()) {
+    if (over_memory()) {
+      budget_hit_ = memory_hit_ = true;
+      break;
+    }
+    const std::vector<Split> decision =
+        choose_splits(hierarchy_, links_, threshold, reference_radiance_, limits_);
+    SplitLinks round = split_links(hierarchy_, links_, decision, limits_);
+    budget_hit_ = budget_hit_ || round.budget_hit;
+    hand_down_links(hierarchy_, options_.leaf_links, round);
+    const bool lights_changed = refine_light_links(threshold);
+    if (round.fresh.empty()) {
+      if (lights_changed) {
+        changed = true;
+        continue;
+      }
+      break;
+    }
+    changed = true;
+    std::vector<Link> made = evaluate(std::move(round.fresh));
+    if (cut_short_) {  // a partial evaluation is discarded with the pass
+      refinement_cut_short_ = true;
+      break;
+    }
+    for (const Link& l : made) hierarchy_.element(l.receiver).has_links = 1;
+    round.kept.insert(round.kept.end(), made.begin(), made.end());
+    links_ = std::move(round.kept);
+    ++links_version_;
+    track_memory();
+    report(SolvePhase::Refining, (pass_ + 0.5) / (passes_ + 1.0));
+  }
+  if (changed) {
+    // Growth by doubling leaves up to half of each array unused until the next
+    // refinement: give it back.
+    links_.shrink_to_fit();
+    hierarchy_.shrink_to_fit();
+    track_memory();
+  }
+  return changed;
+}
+
+// Light links above the threshold split their receivers (refine.h); then every
+// light link whose receiver was split (by it or by any link) is replaced by
+// its children's. Returns whether the light links changed.
+bool Solver::refine_light_links(double threshold) {
+  if (light_links_.empty()) return false;
+  if (split_light_receivers(hierarchy_, scene_.lights, light_links_, threshold, reference_radiance_,
+                            limits_))
+    budget_hit_ = true;
+  std::vector<LightLink> fresh = hand_down_light_links(hierarchy_, light_links_);
+  if (fresh.empty()) return false;
+  std::vector<LightLink> made = evaluate_light_links(direct_, std::move(fresh));
+  for (const LightLink& l : made) hierarchy_.element(l.receiver).has_links = 1;
+  light_links_.insert(light_links_.end(), made.begin(), made.end());
+  ++light_version_;
+  return true;
+}
+
+// What each element gathers from the light links, rebuilt when they change.
+void Solver::gather_direct_light() {
+  if (light_links_.empty() || direct_version_ == light_version_) return;
+  direct_light_.assign(hierarchy_.elements().size(), SampleRgb{});
+  for (const LightLink& l : light_links_) {
+    const Rgb colour = scene_.lights[l.light].colour;
+    SampleRgb& out = direct_light_[static_cast<size_t>(l.receiver)];
+    for (size_t s = 0; s < kMaxSamples; ++s) out[s] += static_cast<double>(l.value[s]) * colour;
+  }
+  direct_version_ = light_version_;
+}
+
+// Groups the links by receiver (counting sort keeps link order within a
+// receiver); rebuilt only when refinement changed the links.
+void Solver::group_links() {
+  const size_t elements = hierarchy_.elements().size();
+  if (links_version_ == grouped_version_ && offset_.size() == elements + 1) return;
+  offset_.assign(elements + 1, 0);
+  for (const Link& l : links_) ++offset_[static_cast<size_t>(l.receiver) + 1];
+  for (size_t i = 1; i < offset_.size(); ++i) offset_[i] += offset_[i - 1];
+  order_.resize(links_.size());
+  order_.shrink_to_fit();
+  std::vector<std::uint32_t> next(offset_.begin(), offset_.end() - 1);
+  for (std::uint32_t i = 0; i < links_.size(); ++i)
+    order_[next[static_cast<size_t>(links_[i].receiver)]++] = i;
+  // Only links whose emitter has been split need its shape.
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, links_.size()), [&](const auto& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      Link& l = links_[i];
+      const Element& emitter = hierarchy_.element(l.emitter);
+      if (emitter.is_leaf() || shape_computed(l.emitter_shape)) continue;
+      dvec3 receiver[4];
+      const int n = hierarchy_.corners(hierarchy_.element(l.receiver), receiver);
+      l.emitter_shape = emitter_shape(hierarchy_, emitter,
+                                      std::span<const dvec3>(receiver, static_cast<size_t>(n)));
+    }
+  });
+  balance_.update(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, clusters_,
+                  cluster_links_, cluster_gather_);
+  grouped_version_ = links_version_;
+}
+
+void Solver::gather_far_light() {
+  if (cluster_links_.empty()) return;
+  far_light_.resize(static_cast<size_t>(scene_.patches.size()) *
+                    2);  // top-level elements come first
+  cluster_gather_(clusters_, cluster_links_, hierarchy_, source_, far_light_);
+}
+
+// One Jacobi iteration: the links read the radiances as they are now.
+double Solver::gather_push_pull() {
+  group_links();
+  balance_.sent_radiances(hierarchy_, source_);
+  gather_far_light();
+  gather_direct_light();
+  return push_pull(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_,
+                   balance_.down_scale(), direct_light_);
+}
+
+// Refine, gather, push/pull until converged (or `max_iterations`). Returns the
+// last residual.
+double Solver::iterate(double threshold, int max_iterations, double tolerance) {
+  double residual = 0.0;
+  // Radiance change since refinement last found nothing to do: decisions can
+  // only change once the radiances they read have moved (a converging
+  // high-albedo scene iterates hundreds of times without new refinement).
+  double drift = std::numeric_limits<double>::infinity();
+  TailExtrapolation tail;
+  for (int i = 0; i < max_iterations && !pass_abandoned(); ++i) {
+    bool refined = false;
+    if (drift > 1e-3) {
+      refined = refine(threshold);
+      drift = refined ? std::numeric_limits<double>::infinity() : 0.0;
+    }
+    if (pass_abandoned()) break;
+    const auto start = Clock::now();
+    tail.before(hierarchy_);
+    residual = gather_push_pull();
+    const bool extrapolated = tail.after(hierarchy_, residual, refined);
+    stats_.seconds_gather += seconds_since(start);
+    ++stats_.iterations;
+    stats_.residual = residual;
+    if (std::isfinite(drift)) drift += residual;
+    if (extrapolated) continue;  // not converged until an iteration confirms it
+    // A pass cut short by the element budget is the last: converge it fully.
+    if (!refined && residual < (budget_hit_ ? options_.tolerance : tolerance)) break;
+    // The budget ends the pass once an iteration has gathered (from the last refinement, if any).
+    if (out_of_time()) break;
+  }
+  return residual;
+}
+
+void Solver::snapshot(double threshold) {
+  // The same radiances as the last iteration read: this push/pull repeats it,
+  // keeping what each leaf sample gathered. Before the first iteration nothing
+  // has been gathered yet (emitters only): the links read zero.
+  std::vector<std::array<Rgb, kMaxSamples>> leaf(hierarchy_.elements().size());
+  source_.resize(hierarchy_.elements().size(), Rgb(0.0));
+  group_links();
+  gather_far_light();
+  gather_direct_light();
+  push_pull(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_,
+            balance_.down_scale(), direct_light_, &leaf);
+  result_.mesh = make_output_mesh(hierarchy_, leaf);
+  stats_.threshold = threshold;
+}
+
+SolveResult Solver::run() {
+  report(SolvePhase::Linking, 0.0);
+  link_initially();
+  const bool fixed_bounces = options_.bounces.has_value();
+  const double target = quality_threshold(options_.oracle, options_.quality);
+
+  // Threshold of each pass: pass 0 solves without refinement, later passes
+  // lower the threshold geometrically to the target. Fixed bounces: one pass.
+  std::vector<double> thresholds;
+  if (fixed_bounces) {
+    thresholds.push_back(target);
+  } else {
+    thresholds.push_back(std::numeric_limits<double>::infinity());
+    if (std::isfinite(target)) {
+      const int steps = std::max(1, static_cast<int>(std::ceil(6 * options_.quality)));
+      for (int k = 1; k <= steps; ++k) {
+        thresholds.push_back(quality_threshold(options_.oracle, options_.quality * k / steps));
+      }
+    }
+  }
+  passes_ = static_cast<int>(thresholds.size());
+  stats_.stopped_by = StopReason::Quality;
+  if (!cancelled()) snapshot(std::numeric_limits<double>::infinity());  // emitters only
+  for (pass_ = 0; pass_ < passes_; ++pass_) {
+    if (cancelled()) break;
+    threshold_ = thresholds[static_cast<size_t>(pass_)];
+    const bool last = pass_ + 1 == passes_;
+    if (fixed_bounces) {
+      iterate(threshold_, *options_.bounces, -1.0);
+    } else {
+      iterate(threshold_, options_.max_iterations, last ? options_.tolerance : 1e-3);
+    }
+    if (pass_abandoned()) break;
+    snapshot(threshold_);
+    stats_.passes = pass_ + 1;
+    report(SolvePhase::Pass, (pass_ + 1.0) / passes_);
+    if (budget_hit_) {
+      stats_.stopped_by = memory_hit_ ? StopReason::Memory : StopReason::MaxElements;
+      break;
+    }
+    if (out_of_time()) {
+      stats_.stopped_by = StopReason::TimeBudget;
+      break;
+    }
+  }
+  if (refinement_cut_short_) stats_.stopped_by = StopReason::TimeBudget;
+  if (cancelled()) {
+    stats_.cancelled = true;
+    stats_.stopped_by = StopReason::Cancel;
+  }
+  const auto& elements = hierarchy_.elements();
+  stats_.elements = elements.size();
+  stats_.leaves = static_cast<size_t>(std::count_if(elements.begin(), elements.end(),
+                                                    [](const Element& e) { return e.is_leaf(); }));
+  stats_.links = links_.size();
+  stats_.cluster_links = cluster_links_.size();
+  stats_.light_links = light_links_.size();
+  stats_.skipped_faces = scene_.skipped.size();
+  stats_.repaired_faces = scene_.repaired.size();
+  track_memory();
+  stats_.seconds = elapsed();
+  result_.stats = stats_;
+  report(SolvePhase::Done, 1.0);
+  return std::move(result_);
+}
+
+}  // namespace
+
+std::size_t estimated_base_bytes(const Scene& scene) {
+  // Per patch: two sides' elements with their gather state, the cluster tree
+  // (about two nodes per side), and Embree's BVH (about 128 bytes a primitive).
+  constexpr std::size_t kPerSide = sizeof(Element) + 2 * sizeof(ClusterNode) + 4 * sizeof(Rgb);
+  constexpr std::size_t kPerPatch = sizeof(Patch) + 2 * kPerSide + 128;
+  return scene.patches.size() * kPerPatch;
+}
+
+double quality_threshold(Oracle oracle, double quality) {
+  if (!(quality > 0.0)) return std::numeric_limits<double>::infinity();
+  const ThresholdRange range = threshold_range(oracle);
+  const double q = std::min(quality, 1.0);
+  return range.coarse * std::pow(range.fine / range.coarse, q);
+}
+
+SolveResult solve(const Scene& scene, const SolveOptions& options, const ProgressCallback& progress,
+                  const CancelCheck& cancel) {
+  if (!(options.quality >= 0.0 && options.quality <= 1.0)) {
+    throw std::invalid_argument("quality must lie in [0, 1]");
+  }
+  if (options.max_elements && *options.max_elements == 0) {
+    throw std::invalid_argument("max_elements must be positive");
+  }
+  if (options.time_budget && !(*options.time_budget > 0.0)) {
+    throw std::invalid_argument("time_budget must be positive seconds");
+  }
+  if (options.rays < 1 || options.rays > kMaxRays)
+    throw std::invalid_argument("rays must lie in [1, " + std::to_string(kMaxRays) + "]");
+  if (options.bounces && *options.bounces < 1)
+    throw std::invalid_argument("bounces must be at least 1");
+  if (options.threads && (*options.threads < 1 || *options.threads > kMaxThreads))
+    throw std::invalid_argument("threads must lie in [1, " + std::to_string(kMaxThreads) + "]");
+  if (!(options.min_element_area > 0.0 && options.min_element_area < 1.0)) {
+    throw std::invalid_argument("min_element_area must lie in (0, 1)");
+  }
+  SolveOptions checked = options;
+  if (!checked.memory_limit) checked.memory_limit = available_memory() / 4 * 3;
+  const std::size_t needed = estimated_base_bytes(scene);
+  if (needed > *checked.memory_limit) {
+    std::ostringstream m;
+    m << "the scene needs about " << gigabytes(needed)
+      << " GB before any refinement, more than the " << gigabytes(*checked.memory_limit)
+      << " GB the solve may use (" << scene.patches.size()
+      << " planar pieces); solve fewer or simpler objects";
+    throw InsufficientMemory(m.str());
+  }
+  tbb::task_arena arena(options.threads ? *options.threads : tbb::task_arena::automatic);
+  SolveResult result =
+      arena.execute([&] { return Solver(scene, checked, progress, cancel).run(); });
+  require_finite(result.mesh);
+  return result;
+}
+
+}  // namespace radiosity

@@ -1,0 +1,189 @@
+// Hierarchical radiosity (Hanrahan, Salzman and Aupperle 1991) with a pluggable
+// refinement oracle (DESIGN s5-6): initial links between facing top-level
+// patches, then passes of decreasing threshold, each iterating
+// refine -> gather -> push/pull until the radiance converges. Every pass reuses
+// the elements and links already made, so the solve can stop at any time (a
+// budget, or cancel) with the best complete solution so far.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "radiosity/output_mesh.h"
+#include "radiosity/scene.h"
+
+namespace radiosity {
+
+// More worker threads than any machine this runs on has cores.
+inline constexpr int kMaxThreads = 1024;
+// Shadow rays per sample point and emitter in sampled visibility: at most this.
+inline constexpr int kMaxRays = 65536;
+
+// Thrown before any work when even the unrefined solve would not fit in the
+// memory limit (Python: MemoryError, with this message).
+struct InsufficientMemory : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Bytes an unrefined solve of `scene` needs at least (patches, elements, the
+// cluster tree and the ray-tracing structure): the estimate the memory limit
+// is checked against before allocating.
+std::size_t estimated_base_bytes(const Scene& scene);
+
+// What decides where to refine (DESIGN s6; core/solve/oracle.h has the criteria).
+enum class Oracle : std::uint8_t {
+  Standard,    // BF: (F_max - F_min) A_p                              (eq. 6)
+  Perceptual,  // k max r_ij, from values and tangential slopes        (eqs. 25-28)
+  Gradient,    // max |pr(grad F_i) - pr(grad F_j)| A_p                (eqs. 18-20)
+};
+
+// How partly occluded links see their emitter: the exact visible polygon, or
+// shadow rays.
+enum class VisibilityMode : std::uint8_t { Exact, Sampled };
+
+struct SolveOptions {
+  Oracle oracle = Oracle::Perceptual;
+  // 0 = no refinement (the coarsest solution), 1 = the finest the oracle's
+  // threshold scale allows; see quality_threshold().
+  double quality = 0.5;
+  std::optional<std::size_t> max_elements;  // element budget
+  std::optional<double> time_budget;        // seconds
+  // Bytes the elements and links may hold; refinement stops there (stopped_by
+  // "memory"), and a scene whose unrefined solve cannot fit is refused before
+  // any allocation. Default: 3/4 of the memory available when the solve starts.
+  std::optional<std::size_t> memory_limit;
+  VisibilityMode visibility = VisibilityMode::Exact;
+  int rays = 16;  // in [1, kMaxRays]
+  // When set: one pass at the target threshold, with exactly this many
+  // refine/gather/push-pull iterations from L = L_e (the source's 3-iteration runs).
+  std::optional<int> bounces;
+  std::optional<int> threads;  // in [1, kMaxThreads]; default: all cores
+  // Smallest element, as a fraction of the scene's total area (1e-5 of an
+  // 80 m2 room is a 3 cm square).
+  double min_element_area = 1e-5;
+  // Which links a split receiver hands down to its children, to be gathered
+  // at their own samples instead of pushed down as interpolated values
+  // (native/README.md): none (textbook HR), near-field ones (the emitter is
+  // closer than the receiver's size), or all, with near-field links from a
+  // split emitter handed to its children too (conserves energy to 1e-3, 3 to
+  // 5 times more links).
+  enum class LeafLinks : std::uint8_t { None, Near, All };  // "none", "near", "all"
+  LeafLinks leaf_links = LeafLinks::Near;
+  // Clusters of patch sides whose centres are further apart than this many
+  // times the sum of their radii exchange light through one cluster link
+  // (cluster_links.h); infinity: every pair of patch sides is linked;
+  // 0: from the quality, 2 at 0 to 10 at 1.
+  double cluster_separation = 0.0;
+  double tolerance = 1e-6;  // relative change of radiance that counts as converged
+  int max_iterations = 5000;
+};
+
+// What the solve is doing when it reports progress.
+enum class SolvePhase : std::uint8_t {
+  Linking,   // the initial links
+  Refining,  // a round of refinement made new links
+  Pass,      // a pass ended: its solution stands
+  Done,
+};
+
+// Why the solve stopped.
+enum class StopReason : std::uint8_t { Quality, MaxElements, Memory, TimeBudget, Cancel };
+
+// The names of the options' and reports' values, as the Python API and the
+// add-on spell them ("perceptual", "exact", "near", "refining", "time_budget"):
+// one table per enum (core/solve/option_names.cpp).
+std::optional<Oracle> parse_oracle(std::string_view name);
+std::string_view oracle_name(Oracle oracle);
+std::optional<VisibilityMode> parse_visibility(std::string_view name);
+std::string_view visibility_name(VisibilityMode mode);
+std::optional<SolveOptions::LeafLinks> parse_leaf_links(std::string_view name);
+std::string_view leaf_links_name(SolveOptions::LeafLinks links);
+std::string_view phase_name(SolvePhase phase);
+std::string_view stop_reason_name(StopReason reason);
+
+// SolveOptions{} and the limits as a JSON object, by the names above: the
+// defaults the add-on's settings start from (solver_defaults.json, written at
+// build time by native/generate/write_defaults.cpp) and `_radiosity.DEFAULTS`.
+std::string defaults_json();
+
+struct SolveProgress {
+  int pass = 0;
+  int passes = 0;
+  SolvePhase phase = SolvePhase::Linking;
+  std::size_t elements = 0;
+  std::size_t links = 0;
+  double threshold = 0.0;
+  double seconds = 0.0;
+  double fraction = 0.0;  // rough overall progress in [0, 1]
+};
+
+// CPU seconds spent in each part of link evaluation (summed over threads), and
+// how many form factors were computed: clear of occluders, through the visible
+// polygon or shadow rays, or taken from a sibling (CornerMemo).
+struct LinkTimings {
+  double visibility = 0.0;
+  double form_factors = 0.0;
+  double oracle = 0.0;
+  std::uint64_t samples_clear = 0;
+  std::uint64_t samples_occluded = 0;
+  std::uint64_t samples_shared = 0;
+  LinkTimings& operator+=(const LinkTimings& o) {
+    visibility += o.visibility;
+    form_factors += o.form_factors;
+    oracle += o.oracle;
+    samples_clear += o.samples_clear;
+    samples_occluded += o.samples_occluded;
+    samples_shared += o.samples_shared;
+    return *this;
+  }
+};
+
+struct SolveStats {
+  std::size_t elements = 0;
+  std::size_t leaves = 0;
+  std::size_t links = 0;
+  std::size_t cluster_links = 0;
+  std::size_t light_links = 0;  // leaf and light pairs of direct light (direct_light.h)
+  int passes = 0;
+  int iterations = 0;
+  double residual = 0.0;   // relative change of the last iteration
+  double threshold = 0.0;  // of the last complete pass
+  std::size_t skipped_faces = 0;
+  std::size_t repaired_faces = 0;  // solved after a repair (Scene::repaired)
+  bool cancelled = false;
+  StopReason stopped_by = StopReason::Quality;
+  double seconds = 0.0;
+  double seconds_linking = 0.0;
+  double seconds_clustering = 0.0;  // of linking: the walk over cluster pairs, with its rays
+  LinkTimings link_cpu;             // CPU seconds over all threads
+  double seconds_gather = 0.0;      // gather and push/pull, wall clock
+  std::size_t element_bytes = 0;
+  std::size_t link_bytes = 0;
+  std::size_t peak_bytes = 0;  // peak of the solver's own structures
+};
+
+struct SolveResult {
+  OutputMesh mesh;
+  SolveStats stats;
+};
+
+// Thresholds of the oracle at a quality level: log-spaced from the largest
+// (quality -> 0) to the smallest (quality = 1). Quality 0 means no refinement.
+double quality_threshold(Oracle oracle, double quality);
+
+using ProgressCallback = std::function<void(const SolveProgress&)>;
+
+// Polled often from the solving thread; true stops the solve.
+using CancelCheck = std::function<bool()>;
+
+// Solves; throws std::invalid_argument for bad options. When `cancelled`
+// turns true (set from another thread) the solve returns the last complete
+// pass promptly.
+SolveResult solve(const Scene& scene, const SolveOptions& options,
+                  const ProgressCallback& progress = {}, const CancelCheck& cancelled = {});
+
+}  // namespace radiosity
