@@ -6,6 +6,9 @@ interface (`scene.radiosity.oracle = 'PERCEPTUAL'`); tests and batch scripts
 rely on them, so they do not change.
 """
 
+import json
+import pathlib
+
 import bpy
 from bpy.props import (
     BoolProperty,
@@ -16,6 +19,12 @@ from bpy.props import (
     StringProperty,
 )
 from bpy.types import PropertyGroup
+
+# The solver's own defaults and limits (SolveOptions{} in the native core),
+# written into the package when it is built (solver_defaults.json): each is
+# defined once, in C++, and the settings still register when the native
+# module cannot load.
+SOLVER_DEFAULTS = json.loads(pathlib.Path(__file__).with_name("solver_defaults.json").read_text())
 
 ORACLE_ITEMS = (
     ('STANDARD', "Standard",
@@ -116,7 +125,7 @@ class RadiositySettings(PropertyGroup):
         name="Oracle",
         description="How the solver decides where to refine the mesh",
         items=ORACLE_ITEMS,
-        default='PERCEPTUAL',
+        default=SOLVER_DEFAULTS["oracle"].upper(),
     )
     quality: FloatProperty(
         name="Quality",
@@ -128,7 +137,7 @@ class RadiositySettings(PropertyGroup):
         ),
         min=0.0,
         max=1.0,
-        default=0.5,
+        default=SOLVER_DEFAULTS["quality"],
         subtype='FACTOR',
     )
     max_elements: IntProperty(
@@ -154,10 +163,10 @@ class RadiositySettings(PropertyGroup):
         name="Smallest Element",
         description=(
             "Elements are not split below this edge length (0: automatic, elements down "
-            "to 1/100,000 of the scene's surface area). The perceptual and gradient "
+            "to 1/%s of the scene's surface area). The perceptual and gradient "
             "oracles refine the thin shadows of chair and table legs down to this "
             "size at any quality, so in furnished rooms it sets their cost"
-        ),
+        ) % format(round(1.0 / SOLVER_DEFAULTS["min_element_area"]), ","),
         min=0.0,
         default=0.0,
         subtype='DISTANCE',
@@ -166,15 +175,15 @@ class RadiositySettings(PropertyGroup):
         name="Visibility",
         description="How occlusion between surfaces is computed",
         items=VISIBILITY_ITEMS,
-        default='EXACT',
+        default=SOLVER_DEFAULTS["visibility"].upper(),
     )
     rays: IntProperty(
         name="Rays",
         description="Shadow rays per sample point and emitter for sampled visibility",
         min=1,
         soft_max=256,
-        max=4096,
-        default=16,
+        max=SOLVER_DEFAULTS["max_rays"],
+        default=SOLVER_DEFAULTS["rays"],
     )
     bounces: IntProperty(
         name="Bounces",

@@ -12,7 +12,7 @@ quads (a fan for larger polygons).
 
 Values are computed per result corner, not per result vertex: a UV map is
 face-corner data, and a corner always knows its polygon's source face, so a
-vertex shared by polygons of different faces (native/core/output_mesh.cpp
+vertex shared by polygons of different faces (native/core/hierarchy/output_mesh.cpp
 shares vertices only within one side of one input face) would be handled too.
 """
 

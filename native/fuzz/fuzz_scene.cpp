@@ -1,5 +1,5 @@
 // libFuzzer harness of scene validation (make_scene from SceneArrays, scene.h)
-// and, for inputs that ask for it, a small solve of the scene (solver.h):
+// and, for inputs that ask for it, a small solve of the scene (radiosity/solve.h):
 // `make fuzz`. make_scene must turn any arrays into a scene or throw
 // std::invalid_argument; solve() must return finite radiance and positions or
 // throw std::invalid_argument. Findings: a sanitizer report, another

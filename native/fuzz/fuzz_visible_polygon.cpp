@@ -4,7 +4,7 @@
 // triangles at once (visible_form_factor_gradient_parts, as a split emitter is
 // evaluated). The emitter, point and normal pass the checks the Python
 // bindings make (visible_polygon(), visible_form_factor()); occluders are any
-// triangles within kMaxCoordinate (core/scene.h), as the bindings take them.
+// triangles within kMaxCoordinate (include/radiosity/scene.h), as the bindings take them.
 // Findings: a sanitizer report, a non-finite value, a hang.
 //
 // Input: u8 flags; point; normal; emitter (fuzz_input.h, read_polygon); u16

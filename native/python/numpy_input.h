@@ -45,7 +45,7 @@ InputArray<double> read_array(const pybind11::handle& object, const std::string&
 // Throws if any value of the array is NaN or infinite.
 void require_finite(const double* data, size_t count, const std::string& name);
 
-// Throws if any value's magnitude exceeds kMaxCoordinate (core/scene.h): the
+// Throws if any value's magnitude exceeds kMaxCoordinate (include/radiosity/scene.h): the
 // kernels take points, polygons and occluders in the range a scene may have
 // (their products of four lengths overflow near 1e77, and beyond 1e154 the
 // visible-polygon code made NaN; libFuzzer visible_polygon, crash-516ec420).

@@ -142,6 +142,16 @@ class DefaultsTest(unittest.TestCase):
         self.assertFalse(s.show_wireframe)
         self.assertFalse(s.stats.valid)
 
+    def test_defaults_are_the_solvers(self):
+        """Each setting the solver also has starts at the solver's default (one definition, in C++)."""
+        defaults = native.load().DEFAULTS
+        s = self.settings
+        self.assertEqual(s.oracle.lower(), defaults["oracle"])
+        self.assertEqual(s.visibility.lower(), defaults["visibility"])
+        self.assertAlmostEqual(s.quality, defaults["quality"], places=6)
+        self.assertEqual(s.rays, defaults["rays"])
+        self.assertEqual(s.bl_rna.properties["rays"].hard_max, defaults["max_rays"])
+
     def test_every_default_within_its_range(self):
         for group in (self.settings, self.settings.stats):
             for prop in group.bl_rna.properties:

@@ -1,4 +1,4 @@
-"""Contact meshing (native/core/contact.h): faces that lie on, near or through
+"""Contact meshing (native/core/scene/contact.h): faces that lie on, near or through
 other faces are split along them, coinciding faces are merged, and no light
 leaks through the seams: closed boxes stay closed, a light a hair under a
 ceiling lights the room as a flush one does, a doubled wall counts once.

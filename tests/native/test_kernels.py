@@ -1,6 +1,6 @@
 """Python access to the form-factor kernels: values, gradients and input validation.
 
-The C++ unit tests (native/tests/form_factor_test.cpp) prove the kernels
+The C++ unit tests (native/core/geometry/form_factor_test.cpp) prove the kernels
 themselves; these prove the binding carries the numbers across unchanged and
 turns every bad argument into a ValueError that names it.
 """
@@ -92,7 +92,7 @@ class FormFactorValidation(unittest.TestCase):
         self.assert_value_error("polygon must be", [0, 0, 0], UP, "square")
 
     def test_coordinates_beyond_the_scene_range(self):
-        # Beyond kMaxCoordinate (1e30, core/scene.h) the kernels' products of
+        # Beyond kMaxCoordinate (1e30, include/radiosity/scene.h) the kernels' products of
         # lengths overflow (NaN visible-polygon anchors from 1e154 occluders).
         self.assert_value_error("point has a coordinate of magnitude", [0, 0, 1e31], UP, SQUARE)
         self.assert_value_error("polygon has a coordinate of magnitude", [0, 0, 0], UP, SQUARE * 1e31)

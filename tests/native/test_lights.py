@@ -1,4 +1,4 @@
-"""Direct light from lights that are not surfaces (native/core/direct_light.h):
+"""Direct light from lights that are not surfaces (native/core/solve/direct_light.h):
 point, spot and sun lights and a uniform world, against closed forms.
 
 Units: a receiver gathers H (irradiance / pi, radiance units) and shows

@@ -39,6 +39,20 @@ class ModuleTest(unittest.TestCase):
         with open(manifest, "rb") as f:
             self.assertEqual(tomllib.load(f)["version"], _radiosity.__version__)
 
+    def test_addon_defaults_are_the_modules(self):
+        """The add-on's settings start from solver_defaults.json, written by the
+        build from the same SolveOptions{} the module's solve() defaults to."""
+        import json
+
+        import _radiosity
+
+        packaged = pathlib.Path(_radiosity.__file__).with_name("solver_defaults.json")
+        self.assertEqual(json.loads(packaged.read_text()), _radiosity.DEFAULTS)
+        self.assertIn(_radiosity.DEFAULTS["oracle"], ("standard", "perceptual", "gradient"))
+        self.assertIn(_radiosity.DEFAULTS["visibility"], ("exact", "sampled"))
+        self.assertTrue(0.0 < _radiosity.DEFAULTS["quality"] <= 1.0)
+        self.assertTrue(1 <= _radiosity.DEFAULTS["rays"] <= _radiosity.DEFAULTS["max_rays"])
+
     def test_has_docstring(self):
         import _radiosity
 

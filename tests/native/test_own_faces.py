@@ -4,7 +4,7 @@ The solver skips the receiver's and the emitter's input faces when it looks for
 what blocks a link: shaft culling leaves them out of the candidates (exact
 visibility, and sampled visibility with few candidates), and past 32 candidates
 sampled visibility casts its rays through Embree with a per-query filter that
-rejects hits on them (core/ray_scene.cpp: a context filter function). An Embree
+rejects hits on them (native/core/visibility/ray_scene.cpp: a context filter function). An Embree
 built without filter functions (EMBREE_FILTER_FUNCTION=OFF) ignores that filter
 without an error, and every face folded or bent between a receiver and its
 light then shadows it in sampled mode only. These tests run in the module the

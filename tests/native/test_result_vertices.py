@@ -1,5 +1,5 @@
 """What the bake's per-vertex data relies on in the solver's output mesh
-(native/core/output_mesh.cpp), checked on solved synthetic scenes:
+(native/core/hierarchy/output_mesh.cpp), checked on solved synthetic scenes:
 
 - a result vertex is shared only by polygons of the same input face and side
   (addon/surface_uv.py interpolates UVs per corner anyway, so a vertex with one

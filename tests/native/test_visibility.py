@@ -1,6 +1,6 @@
 """Python access to occluded form factors: visible_form_factor(), exact and sampled.
 
-The C++ tests (native/tests/visibility_test.cpp, shaft_test.cpp) prove the visible
+The C++ tests (native/core/visibility/visibility_test.cpp, shaft_test.cpp) prove the visible
 polygon, its gradient, the sampled mode and shaft culling; these prove the binding
 carries the numbers across and turns every bad argument into a ValueError.
 Run by tests/run_tests.py with build/addon/radiosity on sys.path.
