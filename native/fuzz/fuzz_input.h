@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/geometry/form_factor.h"
+#include "core/geometry/polygon.h"
 #include "core/visibility/visible_polygon.h"
 #include "radiosity/scene.h"
 #include "radiosity/vec.h"
@@ -84,14 +85,7 @@ inline bool valid_polygon(std::span<const dvec3> polygon) {
   if (n < 3) return false;
   for (const dvec3& v : polygon)
     if (!in_range(v)) return false;
-  dvec3 area_normal(0.0);
-  double diameter = 0.0;
-  for (std::size_t i = 1; i + 1 < n; ++i)
-    area_normal += glm::cross(polygon[i] - polygon[0], polygon[i + 1] - polygon[0]);
-  for (std::size_t i = 1; i < n; ++i)
-    diameter = std::max(diameter, glm::length(polygon[i] - polygon[0]));
-  return glm::length(area_normal) > 1e-12 * diameter * diameter && diameter > 0.0 &&
-         std::isfinite(glm::length(area_normal));
+  return encloses_area(polygon);
 }
 
 // python/bind_visibility.cpp, require_planar_convex.

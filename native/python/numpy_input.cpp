@@ -108,11 +108,7 @@ std::vector<dvec3> read_polygon(const py::handle& object, const std::string& nam
   for (size_t i = 0; i < n; ++i) polygon[i] = {p[3 * i], p[3 * i + 1], p[3 * i + 2]};
   // Zero-area and collinear polygons are rejected here, with the reason, so the
   // kernels never see them (MATH.md s3).
-  const dvec3 area_normal = twice_area_normal(polygon);
-  double diameter = 0.0;
-  for (size_t i = 1; i < n; ++i)
-    diameter = std::max(diameter, glm::length(polygon[i] - polygon[0]));
-  if (!(glm::length(area_normal) > 1e-12 * diameter * diameter) || !(diameter > 0.0)) {
+  if (!encloses_area(polygon)) {
     throw std::invalid_argument(name + " has zero area (collinear or coincident vertices)");
   }
   return polygon;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <span>
 
 #include "radiosity/vec.h"
@@ -38,6 +39,18 @@ inline double polygon_diameter(std::span<const dvec3> polygon) {
     for (std::size_t j = i + 1; j < polygon.size(); ++j)
       d = std::max(d, glm::length(polygon[j] - polygon[i]));
   return d;
+}
+
+// Does the polygon enclose area beyond rounding? Its area normal must exceed
+// 1e-12 of the square of its extent from the first corner: zero-area,
+// collinear and coincident polygons do not, and the kernels need them not to
+// reach them (MATH.md s3). The bindings and the fuzzers check with this.
+inline bool encloses_area(std::span<const dvec3> polygon) {
+  double extent = 0.0;
+  for (std::size_t i = 1; i < polygon.size(); ++i)
+    extent = std::max(extent, glm::length(polygon[i] - polygon[0]));
+  const double area = glm::length(twice_area_normal(polygon));
+  return std::isfinite(area) && area > 1e-12 * extent * extent && extent > 0.0;
 }
 
 }  // namespace radiosity
