@@ -271,7 +271,8 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
                   const std::string& visibility, const py::object& rays, const py::object& bounces,
                   const py::object& threads, const py::object& progress, const py::object& cancel,
                   double min_element_area, const std::string& leaf_links,
-                  std::optional<double> cluster_separation, const py::object& memory_limit) {
+                  std::optional<double> cluster_separation, const py::object& memory_limit,
+                  bool pass_results) {
   SolveOptions options;
   options.oracle = read_oracle(oracle);
   options.quality = quality;
@@ -327,10 +328,13 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
         d["passes"] = p.passes;
         d["phase"] = std::string(phase_name(p.phase));
         d["elements"] = p.elements;
+        d["leaves"] = p.leaves;
         d["links"] = p.links;
         d["threshold"] = p.threshold;
         d["seconds"] = p.seconds;
         d["fraction"] = p.fraction;
+        // A copy: the solver goes on refining the hierarchy this mesh came from.
+        if (pass_results && p.pass_result) d["result"] = to_python(SolveResult(*p.pass_result));
         progress(d);
       } catch (...) {
         callback_error = std::current_exception();
@@ -475,6 +479,7 @@ void bind_solver(py::module_& m) {
         py::arg("cancel") = py::none(), py::arg("min_element_area") = defaults.min_element_area,
         py::arg("leaf_links") = std::string(leaf_links_name(defaults.leaf_links)),
         py::arg("cluster_separation") = py::none(), py::arg("memory_limit") = py::none(),
+        py::arg("pass_results") = false,
         "Hierarchical radiosity. oracle: 'standard' | 'perceptual' | 'gradient'; quality in\n"
         "[0, 1] (0: no refinement); max_elements, time_budget (s): budgets; visibility:\n"
         "'exact' | 'sampled' (rays per sample); bounces: fixed iteration count instead of\n"
@@ -486,7 +491,10 @@ void bind_solver(py::module_& m) {
         "may hold\n"
         "(default 3/4 of the available memory): refinement stops there (stats['stopped_by'] == "
         "'memory'),\n"
-        "and a scene that cannot fit unrefined raises MemoryError before any work.");
+        "and a scene that cannot fit unrefined raises MemoryError before any work.\n"
+        "progress gets pass, passes (fixed), phase, elements, leaves, links, seconds and fraction\n"
+        "(never decreasing); with pass_results, the 'pass' reports carry 'result': that pass's\n"
+        "solution, as solve() returns it.");
   m.def(
       "quality_threshold",
       [](const std::string& oracle, double quality) {

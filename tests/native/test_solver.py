@@ -492,6 +492,45 @@ class Cancellation(unittest.TestCase):
         self.assertTrue(all(0 <= p["fraction"] <= 1 for p in seen))
         self.assertEqual([p["pass"] for p in passes], list(range(len(passes))))
 
+    def test_progress_is_steady_and_ends_on_the_results_counts(self):
+        # What a progress bar needs: the pass total known from the first report,
+        # a fraction that never goes back, and final counts that are the result's.
+        b, _ = room_with_blocker()
+        for oracle in ORACLES:
+            seen = []
+            result = rad.solve(b.scene(rad), oracle=oracle, quality=0.5, progress=seen.append)
+            self.assertEqual({p["passes"] for p in seen}, {result.stats["passes"]}, oracle)
+            fractions = [p["fraction"] for p in seen]
+            self.assertEqual(fractions, sorted(fractions), oracle)
+            self.assertEqual(fractions[-1], 1.0)
+            done = seen[-1]
+            for key in ("elements", "leaves", "links"):
+                self.assertEqual(done[key], result.stats[key], (oracle, key))
+            # Leaves as reported while refining: the count the hierarchy has.
+            for p in seen:
+                self.assertLessEqual(p["leaves"], p["elements"])
+
+    def test_each_pass_can_hand_over_its_solution(self):
+        b, _ = room_with_blocker()
+        seen = []
+        result = rad.solve(b.scene(rad), oracle="perceptual", quality=0.5, progress=seen.append,
+                           pass_results=True)
+        passes = [p for p in seen if p["phase"] == "pass"]
+        self.assertEqual(len(passes), result.stats["passes"])
+        self.assertTrue(all("result" in p for p in passes))
+        self.assertTrue(all("result" not in p for p in seen if p["phase"] != "pass"))
+        leaves = [p["result"].stats["leaves"] for p in passes]
+        self.assertEqual(leaves, sorted(leaves))
+        self.assertGreater(leaves[-1], leaves[0], "later passes refine")
+        # The last pass's solution is the one returned.
+        last = passes[-1]["result"]
+        np.testing.assert_array_equal(last.radiance, result.radiance)
+        np.testing.assert_array_equal(last.face_vertices, result.face_vertices)
+        # Without asking, no copies are made.
+        plain = []
+        rad.solve(b.scene(rad), oracle="perceptual", quality=0.5, progress=plain.append)
+        self.assertTrue(all("result" not in p for p in plain))
+
     def test_linking_a_large_scene_reports_progress(self):
         # The cluster walk and the face links each report as they go, so a
         # progress bar moves during a long initial linking.

@@ -93,6 +93,7 @@ class Solver {
         direct_(hierarchy_, occluders_, options.visibility, options.rays, options.oracle,
                 oracle_geometric_scale(options.oracle, scene.total_area)),
         limits_{options.min_element_area * scene.total_area, options.max_elements},
+        roots_(hierarchy_.elements().size()),
         memory_limit_(options.memory_limit.value_or(std::numeric_limits<std::size_t>::max())),
         clusters_(hierarchy_) {}
 
@@ -109,7 +110,10 @@ class Solver {
   // abandoned and the last complete one stands.
   bool pass_abandoned() const { return cancelled() || refinement_cut_short_; }
 
-  void report(SolvePhase phase, double fraction);
+  void report(SolvePhase phase, double fraction, const SolveResult* pass_result = nullptr);
+  double pass_fraction(double within) const;
+  std::vector<double> pass_thresholds() const;
+  void count(SolveStats& stats) const;
   void link_initially();
   void drop_links_light_cannot_reach();
   std::vector<Link> evaluate(std::vector<Link>&& candidates);
@@ -137,6 +141,7 @@ class Solver {
   // Brightness the oracles' thresholds are relative to (refine()).
   double reference_radiance_ = 0.0;
   const RefineLimits limits_;
+  const std::size_t roots_;         // elements before any split: every split adds four
   const std::size_t memory_limit_;  // bytes of elements and links (SolveOptions::memory_limit)
   std::vector<Link> links_;
   // Links grouped by receiver for the gather, and which links they describe.
@@ -158,24 +163,41 @@ class Solver {
   bool memory_hit_ = false;
   bool cut_short_ = false;             // the last evaluate_links stopped before the end
   bool refinement_cut_short_ = false;  // ... within refine(): the pass is abandoned
+  std::vector<double> thresholds_;     // one per pass (pass_thresholds)
   int pass_ = 0, passes_ = 1;
+  double fraction_ = 0.0;  // the last reported: progress never goes back
   double threshold_ = std::numeric_limits<double>::infinity();
   SolveStats stats_;
 };
 
-void Solver::report(SolvePhase phase, double fraction) {
+// Progress: the counts as they stand (the Done report: the result's), and a
+// fraction that never goes back.
+void Solver::report(SolvePhase phase, double fraction, const SolveResult* pass_result) {
+  fraction_ = std::max(fraction_, std::clamp(fraction, 0.0, 1.0));
   if (!progress_) return;
   SolveProgress p;
   p.pass = pass_;
   p.passes = passes_;
   p.phase = phase;
-  p.elements = hierarchy_.elements().size();
-  p.links = links_.size();
+  if (phase == SolvePhase::Done) {
+    p.elements = stats_.elements;
+    p.leaves = stats_.leaves;
+    p.links = stats_.links;
+  } else {
+    p.elements = hierarchy_.elements().size();
+    p.leaves = p.elements - (p.elements - roots_) / 4;  // a split makes one leaf four
+    p.links = links_.size();
+  }
   p.threshold = threshold_;
   p.seconds = elapsed();
-  p.fraction = std::clamp(fraction, 0.0, 1.0);
+  p.fraction = fraction_;
+  p.pass_result = pass_result;
   progress_(p);
 }
+
+// Where `within` (0 to 1) of the current pass lies in the whole solve:
+// linking takes the first tenth, each pass an equal share of the rest.
+double Solver::pass_fraction(double within) const { return 0.1 + 0.9 * (pass_ + within) / passes_; }
 
 // Elements: the hierarchy (elements, vertices, midpoints) and the per-element
 // gather tables; links: the links and their receiver grouping.
@@ -320,7 +342,7 @@ bool Solver::refine(double threshold) {
     links_ = std::move(round.kept);
     ++links_version_;
     track_memory();
-    report(SolvePhase::Refining, (pass_ + 0.5) / (passes_ + 1.0));
+    report(SolvePhase::Refining, pass_fraction(0.5));
   }
   if (changed) {
     // Growth by doubling leaves up to half of each array unused until the next
@@ -454,36 +476,47 @@ void Solver::snapshot(double threshold) {
             balance_.down_scale(), direct_light_, &leaf);
   result_.mesh = make_output_mesh(hierarchy_, leaf);
   stats_.threshold = threshold;
+  count(stats_);
+}
+
+// Threshold of each pass: pass 0 solves without refinement, later passes
+// lower the threshold geometrically to the target. Fixed bounces: one pass.
+std::vector<double> Solver::pass_thresholds() const {
+  const double target = quality_threshold(options_.oracle, options_.quality);
+  if (options_.bounces) return {target};
+  std::vector<double> thresholds = {std::numeric_limits<double>::infinity()};
+  if (std::isfinite(target)) {
+    const int steps = std::max(1, static_cast<int>(std::ceil(6 * options_.quality)));
+    for (int k = 1; k <= steps; ++k) {
+      thresholds.push_back(quality_threshold(options_.oracle, options_.quality * k / steps));
+    }
+  }
+  return thresholds;
+}
+
+// The counts of the solution as it stands.
+void Solver::count(SolveStats& stats) const {
+  const auto& elements = hierarchy_.elements();
+  stats.elements = elements.size();
+  stats.leaves = static_cast<size_t>(std::count_if(elements.begin(), elements.end(),
+                                                   [](const Element& e) { return e.is_leaf(); }));
+  stats.links = links_.size();
+  stats.cluster_links = cluster_links_.size();
+  stats.light_links = light_links_.size();
 }
 
 SolveResult Solver::run() {
+  thresholds_ = pass_thresholds();
+  passes_ = static_cast<int>(thresholds_.size());
   report(SolvePhase::Linking, 0.0);
   link_initially();
-  const bool fixed_bounces = options_.bounces.has_value();
-  const double target = quality_threshold(options_.oracle, options_.quality);
-
-  // Threshold of each pass: pass 0 solves without refinement, later passes
-  // lower the threshold geometrically to the target. Fixed bounces: one pass.
-  std::vector<double> thresholds;
-  if (fixed_bounces) {
-    thresholds.push_back(target);
-  } else {
-    thresholds.push_back(std::numeric_limits<double>::infinity());
-    if (std::isfinite(target)) {
-      const int steps = std::max(1, static_cast<int>(std::ceil(6 * options_.quality)));
-      for (int k = 1; k <= steps; ++k) {
-        thresholds.push_back(quality_threshold(options_.oracle, options_.quality * k / steps));
-      }
-    }
-  }
-  passes_ = static_cast<int>(thresholds.size());
   stats_.stopped_by = StopReason::Quality;
   if (!cancelled()) snapshot(std::numeric_limits<double>::infinity());  // emitters only
   for (pass_ = 0; pass_ < passes_; ++pass_) {
     if (cancelled()) break;
-    threshold_ = thresholds[static_cast<size_t>(pass_)];
+    threshold_ = thresholds_[static_cast<size_t>(pass_)];
     const bool last = pass_ + 1 == passes_;
-    if (fixed_bounces) {
+    if (options_.bounces) {
       iterate(threshold_, *options_.bounces, -1.0);
     } else {
       iterate(threshold_, options_.max_iterations, last ? options_.tolerance : 1e-3);
@@ -491,7 +524,9 @@ SolveResult Solver::run() {
     if (pass_abandoned()) break;
     snapshot(threshold_);
     stats_.passes = pass_ + 1;
-    report(SolvePhase::Pass, (pass_ + 1.0) / passes_);
+    stats_.seconds = elapsed();
+    result_.stats = stats_;
+    report(SolvePhase::Pass, pass_fraction(1.0), &result_);
     if (budget_hit_) {
       stats_.stopped_by = memory_hit_ ? StopReason::Memory : StopReason::MaxElements;
       break;
@@ -506,13 +541,7 @@ SolveResult Solver::run() {
     stats_.cancelled = true;
     stats_.stopped_by = StopReason::Cancel;
   }
-  const auto& elements = hierarchy_.elements();
-  stats_.elements = elements.size();
-  stats_.leaves = static_cast<size_t>(std::count_if(elements.begin(), elements.end(),
-                                                    [](const Element& e) { return e.is_leaf(); }));
-  stats_.links = links_.size();
-  stats_.cluster_links = cluster_links_.size();
-  stats_.light_links = light_links_.size();
+  // The counts stay those of the last snapshot: the solution returned.
   stats_.skipped_faces = scene_.skipped.size();
   stats_.repaired_faces = scene_.repaired.size();
   track_memory();

@@ -110,15 +110,23 @@ std::string_view stop_reason_name(StopReason reason);
 // build time by native/generate/write_defaults.cpp) and `_radiosity.DEFAULTS`.
 std::string defaults_json();
 
+struct SolveResult;
+
+// What a progress callback is told. `passes` is fixed from the first report;
+// `fraction` never decreases; the Done report's counts are the result's.
 struct SolveProgress {
   int pass = 0;
   int passes = 0;
   SolvePhase phase = SolvePhase::Linking;
   std::size_t elements = 0;
+  std::size_t leaves = 0;
   std::size_t links = 0;
   double threshold = 0.0;
   double seconds = 0.0;
-  double fraction = 0.0;  // rough overall progress in [0, 1]
+  double fraction = 0.0;  // overall progress in [0, 1]: linking is the first tenth, then passes
+  // With phase Pass: that pass's solution, as solve() would return it if it
+  // stopped there (valid during the call only; copy what is kept).
+  const SolveResult* pass_result = nullptr;
 };
 
 // CPU seconds spent in each part of link evaluation (summed over threads), and
