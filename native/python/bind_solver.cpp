@@ -12,6 +12,7 @@
 #include <atomic>
 #include <exception>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 
@@ -27,6 +28,26 @@ namespace {
 
 struct CancelToken {
   std::atomic<bool> flag{false};
+};
+
+// What a solve running on another thread has reported, for a caller that polls
+// it (Blender's UI timer). The solver thread only copies under a mutex and
+// never waits for Python's GIL, so a busy interface cannot slow the solve (a
+// callback waits for the GIL at every report) and the solve cannot stall it.
+struct ProgressMonitor {
+  std::mutex mutex;
+  std::optional<SolveProgress> latest;     // its pass_result cleared
+  std::optional<SolveResult> pass_result;  // the newest pass's solution, until taken
+  bool keep_pass_results = false;
+
+  void record(const SolveProgress& p) {
+    std::optional<SolveResult> copy;
+    if (keep_pass_results && p.pass_result) copy = *p.pass_result;  // outside the lock
+    const std::lock_guard<std::mutex> lock(mutex);
+    latest = p;
+    latest->pass_result = nullptr;
+    if (copy) pass_result = std::move(copy);
+  }
 };
 
 // Integer input must hold integers: a float array is accepted only if whole.
@@ -229,6 +250,20 @@ PyResult to_python(SolveResult&& r) {
   return out;
 }
 
+py::dict progress_dict(const SolveProgress& p) {
+  py::dict d;
+  d["pass"] = p.pass;
+  d["passes"] = p.passes;
+  d["phase"] = std::string(phase_name(p.phase));
+  d["elements"] = p.elements;
+  d["leaves"] = p.leaves;
+  d["links"] = p.links;
+  d["threshold"] = p.threshold;
+  d["seconds"] = p.seconds;
+  d["fraction"] = p.fraction;
+  return d;
+}
+
 Oracle read_oracle(const std::string& name) {
   const auto oracle = parse_oracle(name);
   if (!oracle) {
@@ -311,28 +346,22 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
       throw std::invalid_argument("cancel must be a CancelToken or None");
     token = cancel.cast<CancelToken*>();
   }
-  if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
-    throw std::invalid_argument("progress must be callable or None");
-  }
   // A failing callback stops the solve; its exception is raised afterwards.
   std::exception_ptr callback_error;
   std::atomic<bool> callback_failed{false};
   ProgressCallback callback;
-  if (!progress.is_none()) {
+  if (py::isinstance<ProgressMonitor>(progress)) {
+    ProgressMonitor* monitor = progress.cast<ProgressMonitor*>();
+    monitor->keep_pass_results = monitor->keep_pass_results || pass_results;
+    callback = [monitor](const SolveProgress& p) { monitor->record(p); };
+  } else if (!progress.is_none()) {
+    if (!PyCallable_Check(progress.ptr()))
+      throw std::invalid_argument("progress must be callable, a ProgressMonitor or None");
     callback = [&](const SolveProgress& p) {
       py::gil_scoped_acquire gil;
       if (callback_error) return;
       try {
-        py::dict d;
-        d["pass"] = p.pass;
-        d["passes"] = p.passes;
-        d["phase"] = std::string(phase_name(p.phase));
-        d["elements"] = p.elements;
-        d["leaves"] = p.leaves;
-        d["links"] = p.links;
-        d["threshold"] = p.threshold;
-        d["seconds"] = p.seconds;
-        d["fraction"] = p.fraction;
+        py::dict d = progress_dict(p);
         // A copy: the solver goes on refining the hierarchy this mesh came from.
         if (pass_results && p.pass_result) d["result"] = to_python(SolveResult(*p.pass_result));
         progress(d);
@@ -368,6 +397,38 @@ void bind_solver(py::module_& m) {
       .def(
           "cancel", [](CancelToken& t) { t.flag = true; }, "Ask the solve to stop.")
       .def_property_readonly("cancelled", [](const CancelToken& t) { return t.flag.load(); });
+
+  py::class_<ProgressMonitor>(
+      m, "ProgressMonitor",
+      "ProgressMonitor(pass_results=False): pass it as solve(progress=...) and poll it from\n"
+      "another thread; the solve never waits for Python to report. progress() is the latest\n"
+      "report (as a progress callback gets it) or None; take_pass_result() the newest pass's\n"
+      "solution not taken yet, or None (with pass_results).")
+      .def(py::init([](bool pass_results) {
+             auto monitor = std::make_unique<ProgressMonitor>();
+             monitor->keep_pass_results = pass_results;
+             return monitor;
+           }),
+           py::arg("pass_results") = false)
+      .def("progress",
+           [](ProgressMonitor& monitor) -> py::object {
+             std::optional<SolveProgress> latest;
+             {
+               const std::lock_guard<std::mutex> lock(monitor.mutex);
+               latest = monitor.latest;
+             }
+             if (!latest) return py::none();
+             return progress_dict(*latest);
+           })
+      .def("take_pass_result", [](ProgressMonitor& monitor) -> py::object {
+        std::optional<SolveResult> taken;
+        {
+          const std::lock_guard<std::mutex> lock(monitor.mutex);
+          taken.swap(monitor.pass_result);
+        }
+        if (!taken) return py::none();
+        return py::cast(to_python(std::move(*taken)));
+      });
 
   py::class_<Scene>(
       m, "Scene",

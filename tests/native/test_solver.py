@@ -531,6 +531,42 @@ class Cancellation(unittest.TestCase):
         rad.solve(b.scene(rad), oracle="perceptual", quality=0.5, progress=plain.append)
         self.assertTrue(all("result" not in p for p in plain))
 
+    def test_a_monitor_is_polled_from_another_thread(self):
+        # Blender's UI polls a ProgressMonitor from its timer while the solve runs
+        # on a worker thread: the reports and each pass's solution arrive there.
+        import threading
+        import time
+        b, _ = room_with_blocker()
+        monitor = rad.ProgressMonitor(pass_results=True)
+        done = {}
+        worker = threading.Thread(target=lambda: done.setdefault(
+            "result", rad.solve(b.scene(rad), oracle="perceptual", quality=0.5, progress=monitor)))
+        worker.start()
+        polled, taken = [], []
+        while worker.is_alive():
+            report = monitor.progress()
+            if report is not None:
+                polled.append(report)
+            pass_result = monitor.take_pass_result()
+            if pass_result is not None:
+                taken.append(pass_result)
+            time.sleep(0.01)
+        worker.join()
+        result = done["result"]
+        last = monitor.take_pass_result()
+        if last is not None:
+            taken.append(last)
+        self.assertIsNone(monitor.take_pass_result(), "a solution is taken once")
+        final = monitor.progress()
+        self.assertEqual(final["phase"], "done")
+        self.assertEqual(final["leaves"], result.stats["leaves"])
+        fractions = [p["fraction"] for p in polled] + [final["fraction"]]
+        self.assertEqual(fractions, sorted(fractions))
+        self.assertGreaterEqual(len(taken), 1)
+        np.testing.assert_array_equal(taken[-1].radiance, result.radiance)
+        with self.assertRaises(ValueError):
+            rad.solve(b.scene(rad), quality=0.0, progress=42)
+
     def test_linking_a_large_scene_reports_progress(self):
         # The cluster walk and the face links each report as they go, so a
         # progress bar moves during a long initial linking.
