@@ -25,7 +25,7 @@ if "bpy" in locals():
     import importlib
 
     for _name in ("native", "compat", "geometry", "light_units", "surface_uv", "export",
-                  "bake_materials", "bake", "result_state", "display_colours", "game_export", "properties",
+                  "bake_materials", "bake", "scene_transaction", "display_colours", "game_export", "properties",
                   "operators", "ui"):
         if _name in locals():
             importlib.reload(locals()[_name])

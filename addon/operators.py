@@ -23,7 +23,7 @@ import bpy
 import numpy as np
 from bpy.types import Operator
 
-from . import bake, export, game_export, native, result_state
+from . import bake, export, game_export, native, scene_transaction
 
 STATUS = {
     "quality": "Converged",
@@ -322,8 +322,8 @@ class RADIOSITY_OT_solve(Operator):
             convert, material, note = game_export.bake_options(scene)
             if note:
                 warnings.append(note)
-        # One transaction: a failure at any step leaves the scene as it was (result_state.py).
-        with result_state.SceneTransaction(scene, context.view_layer) as transaction:
+        # One transaction: a failure at any step leaves the scene as it was (scene_transaction.py).
+        with scene_transaction.SceneTransaction(scene, context.view_layer) as transaction:
             if mode in {'REFINED', 'BOTH', 'LIGHTING'}:
                 bake.write_refined(scene, job.exported, result, settings.show_wireframe,
                                    convert=convert, material=material, lighting=mode == 'LIGHTING',

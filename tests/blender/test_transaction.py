@@ -1,6 +1,6 @@
 """A solve that fails or is cancelled at any step (the export, the native solve,
 writing its result) leaves the scene exactly as it was, the previous result
-included (addon/result_state.py).
+included (addon/scene_transaction.py).
 
 Each step the operator takes after the native solve (replacing the result
 objects, hiding the originals, showing the results, writing the attribute on
