@@ -24,7 +24,7 @@ if "bpy" in locals():
     # Re-running register after F8 / "Reload Scripts": pick up edited modules.
     import importlib
 
-    for _name in ("native", "compat", "geometry", "light_units", "surface_uv", "export",
+    for _name in ("native", "compat", "arrays", "light_units", "surface_uv", "export",
                   "bake_materials", "bake", "scene_transaction", "display_colours", "game_export", "properties",
                   "operators", "ui"):
         if _name in locals():

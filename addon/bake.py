@@ -1,4 +1,4 @@
-"""Writes a solution into the Blender scene (Blender glue; the array work is geometry.py).
+"""Writes a solution into the Blender scene (Blender glue; the array work is arrays.py).
 
 - Refined output: one mesh object per exported part (object instance or area
   light) in the "Radiosity" collection, carrying the adaptive refinement, with
@@ -22,7 +22,7 @@ import json
 import bpy
 import numpy as np
 
-from . import bake_materials, compat, geometry, surface_uv
+from . import arrays, bake_materials, compat, surface_uv
 from .export import HIDDEN_TAG, RESULT_TAG
 
 COLLECTION_NAME = "Radiosity"
@@ -151,14 +151,14 @@ def write_refined(scene, exported, result, show_wireframe=False, convert=None, m
     the previous result away (default remove_results; a SceneTransaction retires it)."""
     face_part = exported.arrays["face_part"]
     polygon_part = face_part[np.asarray(result.source_face, dtype=np.int64)]
-    pieces = geometry.split_result(result.face_vertices, result.face_sizes, polygon_part,
-                                   len(exported.parts))
+    pieces = arrays.split_result(result.face_vertices, result.face_sizes, polygon_part,
+                                 len(exported.parts))
     face_sizes = np.asarray(result.face_sizes)
     positions = unmoved = np.asarray(result.positions)
     if len(positions):
         extent = float(np.ptp(positions, axis=0).max())
-        positions = geometry.offset_sides(positions, result.face_vertices, face_sizes,
-                                          SIDE_OFFSET * extent)
+        positions = arrays.offset_sides(positions, result.face_vertices, face_sizes,
+                                        SIDE_OFFSET * extent)
     radiance = np.asarray(result.radiance)
     if convert is not None:
         radiance = convert(radiance)
@@ -228,8 +228,8 @@ def write_original(scene, exported, result, convert=None):
     have no "Radiosity" attribute of the user's own. Returns (object name,
     reason) of those skipped.
     """
-    arrays = exported.arrays
-    extent = float(np.ptp(arrays["positions"], axis=0).max()) if len(arrays["positions"]) else 1.0
+    positions = exported.arrays["positions"]
+    extent = float(np.ptp(positions, axis=0).max()) if len(positions) else 1.0
     skipped = []
     starts = np.cumsum([p.face_count for p in exported.parts]) - [p.face_count for p in exported.parts]
     targets = []
@@ -253,9 +253,9 @@ def write_original(scene, exported, result, convert=None):
     points = np.concatenate([t[0].corner_points for t in targets])
     sizes = np.concatenate([t[0].face_sizes for t in targets])
     ids = np.concatenate([np.arange(t[1], t[1] + t[0].face_count) for t in targets])
-    values, _ = geometry.corner_values(points, sizes, ids, result.positions, result.face_vertices,
-                                       result.face_sizes, result.source_face, result.source_side,
-                                       result.radiance, tolerance=1e-7 * max(extent, 1e-9))
+    values, _ = arrays.corner_values(points, sizes, ids, result.positions, result.face_vertices,
+                                     result.face_sizes, result.source_face, result.source_side,
+                                     result.radiance, tolerance=1e-7 * max(extent, 1e-9))
     if convert is not None:
         values = convert(values)
     offset = 0
@@ -268,9 +268,9 @@ def write_original(scene, exported, result, convert=None):
         loop_total = _loop_total(mesh)
         if part.polygons is not None:   # faces left out of the solve stay black
             loop_start, loop_total = loop_start[part.polygons], loop_total[part.polygons]
-        loops = geometry.polygon_corners(loop_start, loop_total, np.arange(len(mesh.loops)))
+        loops = arrays.polygon_corners(loop_start, loop_total, np.arange(len(mesh.loops)))
         if np.linalg.det(np.array(obj.matrix_world)[:3, :3]) < 0:
-            loops = geometry.reverse_polygons(loops, loop_total)
+            loops = arrays.reverse_polygons(loops, loop_total)
         per_loop = np.zeros((len(mesh.loops), 3), dtype=np.float32)
         per_loop[loops] = part_values
         set_colour_attribute(mesh, per_loop, 'CORNER')
