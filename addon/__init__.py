@@ -24,8 +24,8 @@ if "bpy" in locals():
     # Re-running register after F8 / "Reload Scripts": pick up edited modules.
     import importlib
 
-    for _name in ("native", "compat", "arrays", "light_units", "surface_uv", "export",
-                  "bake_materials", "bake", "scene_transaction", "display_colours", "game_export", "properties",
+    for _name in ("native", "compat", "arrays", "light_units", "surface_uv", "bake_materials", "result_state",
+                  "export", "bake", "scene_transaction", "display_colours", "game_export", "properties",
                   "operators", "ui"):
         if _name in locals():
             importlib.reload(locals()[_name])

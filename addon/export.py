@@ -33,11 +33,7 @@ import bpy
 import numpy as np
 
 from . import arrays, compat, light_units, render_visibility, surface_uv
-
-# Objects the add-on itself made, which must never be solved again.
-RESULT_TAG = "radiosity_result"
-# Originals the add-on hid in renders, with their previous state (bake.py).
-HIDDEN_TAG = "radiosity_hidden"
+from .result_state import HIDDEN_TAG, RESULT_TAG
 
 GEOMETRY_TYPES = {'MESH', 'CURVE', 'SURFACE', 'FONT', 'META'}
 DEFAULT_REFLECTANCE = (0.8, 0.8, 0.8)  # a face without material renders as grey 0.8 diffuse

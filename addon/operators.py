@@ -23,7 +23,7 @@ import bpy
 import numpy as np
 from bpy.types import Operator
 
-from . import bake, export, game_export, native, scene_transaction
+from . import bake, export, game_export, native, result_state, scene_transaction
 
 STATUS = {
     "quality": "Converged",
@@ -262,7 +262,7 @@ class RADIOSITY_OT_solve(Operator):
         scene = context.scene
         # What a render shows, the originals the last solve hid included, is read,
         # whatever the viewport hides; every flag is put back after.
-        with bake.OriginalsShown(scene, context.view_layer), export.rendered_shown(context.view_layer):
+        with result_state.OriginalsShown(scene, context.view_layer), export.rendered_shown(context.view_layer):
             exported = export.export_scene(context)
         arrays = exported.arrays
         note = "; ".join(exported.repaired + ([export.unmodelled_message(exported.unmodelled)]
@@ -328,11 +328,11 @@ class RADIOSITY_OT_solve(Operator):
                 bake.write_refined(scene, job.exported, result, settings.show_wireframe,
                                    convert=convert, material=material, lighting=mode == 'LIGHTING',
                                    replace_previous=lambda _: transaction.retire_results())
-                bake.hide_originals(scene, context.view_layer, job.exported.hidden_sources)
-                bake.show_results(scene, True)
+                result_state.hide_originals(scene, context.view_layer, job.exported.hidden_sources)
+                result_state.show_results(scene, True)
             else:
                 transaction.retire_results()
-                bake.restore_originals(scene, context.view_layer)
+                result_state.restore_originals(scene, context.view_layer)
             if mode in {'ORIGINAL', 'BOTH'}:
                 skipped_objects = bake.write_original(scene, job.exported, result, convert=convert)
             bake.set_viewport_attribute_colour()
@@ -380,17 +380,10 @@ class RADIOSITY_OT_toggle_result(Operator):
 
     @classmethod
     def poll(cls, context):
-        return context.scene is not None and bool(bake.result_objects(context.scene))
+        return context.scene is not None and bool(result_state.result_objects(context.scene))
 
     def execute(self, context):
-        scene = context.scene
-        if any(o.get(export.HIDDEN_TAG) for o in scene.objects):
-            bake.restore_originals(scene, context.view_layer)
-            bake.show_results(scene, False)
-        else:
-            sources = {o[export.RESULT_TAG] for o in bake.result_objects(scene)}
-            bake.hide_originals(scene, context.view_layer, sorted(sources))
-            bake.show_results(scene, True)
+        result_state.toggle(context.scene, context.view_layer)
         return {'FINISHED'}
 
 
@@ -407,11 +400,7 @@ class RADIOSITY_OT_clear(Operator):
 
     def execute(self, context):
         scene = context.scene
-        bake.remove_results(scene)
-        coll = bake.result_collection(scene, create=False)
-        if coll is not None and not coll.all_objects:
-            bpy.data.collections.remove(coll)
-        bake.restore_originals(scene, context.view_layer)
+        result_state.clear(scene, context.view_layer)
         bake.remove_original_attributes(scene)
         scene.radiosity.stats.clear()
         return {'FINISHED'}

@@ -12,8 +12,8 @@ previous result for good.
 
 import bpy
 
-from . import bake, bake_materials, compat
-from .export import HIDDEN_TAG, RESULT_TAG
+from . import bake, bake_materials, compat, result_state
+from .result_state import HIDDEN_TAG, ORIGINAL_ATTRIBUTE_TAG, RESULT_TAG
 
 RETIRED_SUFFIX = " (previous radiosity result)"
 
@@ -39,7 +39,7 @@ class SceneTransaction:
 
     def __enter__(self):
         scene, layer = self.scene, self.view_layer
-        self.had_collection = bake.result_collection(scene, create=False) is not None
+        self.had_collection = result_state.result_collection(scene, create=False) is not None
         self.objects = set(bpy.data.objects)
         self.meshes = set(bpy.data.meshes)
         self.materials = set(bpy.data.materials)
@@ -53,13 +53,13 @@ class SceneTransaction:
             if obj.type == 'MESH' and not obj.get(RESULT_TAG) and obj.data not in self.attributes:
                 attr = obj.data.color_attributes.get(bake.ATTRIBUTE)
                 self.attributes[obj.data] = (None if attr is None else _copy_attribute(attr),
-                                             obj.data.get(bake.ORIGINAL_ATTRIBUTE_TAG))
+                                             obj.data.get(ORIGINAL_ATTRIBUTE_TAG))
         self.shading = [(space, space.shading.color_type) for space in _views()]
         return self
 
     def retire_results(self):
         """Take the previous result objects out of the scene, keeping them for a rollback."""
-        coll = bake.result_collection(self.scene, create=False)
+        coll = result_state.result_collection(self.scene, create=False)
         if coll is None:
             return
         for obj in list(coll.objects):
@@ -106,7 +106,7 @@ class SceneTransaction:
             bpy.data.materials.remove(material)
         for material, name in self.retired_materials:
             compat.set_name(bpy.data.materials, material, name)
-        coll = bake.result_collection(self.scene, create=not self.had_collection and bool(self.retired))
+        coll = result_state.result_collection(self.scene, create=not self.had_collection and bool(self.retired))
         for obj, name, mesh_name in self.retired:
             compat.set_name(bpy.data.objects, obj, name)
             if obj.data is not None:
@@ -127,9 +127,9 @@ class SceneTransaction:
                 obj.hide_set(hidden, view_layer=layer)
         for mesh, (saved, tag) in self.attributes.items():
             if tag is None:
-                mesh.pop(bake.ORIGINAL_ATTRIBUTE_TAG, None)
+                mesh.pop(ORIGINAL_ATTRIBUTE_TAG, None)
             else:
-                mesh[bake.ORIGINAL_ATTRIBUTE_TAG] = tag
+                mesh[ORIGINAL_ATTRIBUTE_TAG] = tag
             attrs = mesh.color_attributes
             current = attrs.get(bake.ATTRIBUTE)
             if current is not None:

@@ -14,7 +14,7 @@ import unittest
 import bpy
 import numpy as np
 
-from radiosity import arrays, export
+from radiosity import arrays, export, result_state
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "scenes")))
 import scene_kit as kit  # noqa: E402
@@ -205,7 +205,7 @@ class GeometryTest(unittest.TestCase):
         scene = new_file()
         plane(scene, "Shown")
         plane(scene, "NotRendered").hide_render = True
-        plane(scene, "Result")[export.RESULT_TAG] = "Shown"
+        plane(scene, "Result")[result_state.RESULT_TAG] = "Shown"
         self.assertEqual([p.name for p in export_now().parts], ["Shown"])
 
 

@@ -1,0 +1,151 @@
+"""The radiosity result's state in the scene: what is the result, what it hides.
+
+A solve leaves its marks in the scene as custom properties (the tags below,
+defined only here): the result objects and their "Radiosity" collection, the
+originals hidden while the result is shown (with their state before, to be put
+back), the shared "Radiosity Emission" material and the attributes written on
+original meshes. Finding the result, hiding and restoring the originals,
+toggling between the two and removing the result read these marks. Writing
+the result is bake.py; a solve's rollback is scene_transaction.py.
+"""
+
+import json
+
+import bpy
+
+from . import bake_materials
+
+# Objects the add-on itself made, which must never be solved again.
+RESULT_TAG = "radiosity_result"
+# Originals the add-on hid in renders, with their previous state (hide_originals).
+HIDDEN_TAG = "radiosity_hidden"
+# On an original mesh whose "Radiosity" attribute the add-on wrote: one of the
+# user's own by that name is never overwritten or removed.
+ORIGINAL_ATTRIBUTE_TAG = "radiosity_attribute"
+# The shared "Radiosity Emission" material (bake.emission_material).
+MATERIAL_TAG = "radiosity_material"
+COLLECTION_NAME = "Radiosity"
+
+
+# --- The Radiosity collection ------------------------------------------------------------
+
+def result_collection(scene, create=True):
+    """The scene's collection of result objects (made on demand)."""
+    for coll in scene.collection.children_recursive:
+        if coll.get(RESULT_TAG):
+            return coll
+    if not create:
+        return None
+    coll = bpy.data.collections.new(COLLECTION_NAME)
+    coll[RESULT_TAG] = True
+    scene.collection.children.link(coll)
+    return coll
+
+
+def result_objects(scene):
+    """The result objects of `scene`."""
+    return [o for o in scene.objects if o.get(RESULT_TAG)]
+
+
+def remove_results(scene):
+    """Delete the result objects and their meshes; keep the (emptied) collection."""
+    for obj in result_objects(scene):
+        mesh = obj.data
+        bpy.data.objects.remove(obj)
+        if mesh is not None and mesh.users == 0:
+            bpy.data.meshes.remove(mesh)
+    bake_materials.remove_unused()
+
+
+# --- Showing the result instead of the originals -----------------------------------------
+
+def hide_originals(scene, view_layer, names):
+    """Hide the named originals in renders and the viewport, remembering their state."""
+    for name in names:
+        obj = scene.objects.get(name)
+        if obj is None or obj.get(HIDDEN_TAG):
+            continue
+        in_layer = view_layer.objects.get(name) is not None
+        obj[HIDDEN_TAG] = json.dumps({"hide_render": obj.hide_render,
+                                      "hidden": obj.hide_get(view_layer=view_layer) if in_layer else False})
+        obj.hide_render = True
+        if in_layer:
+            obj.hide_set(True, view_layer=view_layer)
+
+
+def restore_originals(scene, view_layer):
+    """Undo hide_originals. Returns how many objects were restored."""
+    count = 0
+    for obj in scene.objects:
+        state = obj.get(HIDDEN_TAG)
+        if not state:
+            continue
+        state = json.loads(state)
+        obj.hide_render = state["hide_render"]
+        if view_layer.objects.get(obj.name) is not None:
+            obj.hide_set(state["hidden"], view_layer=view_layer)
+        del obj[HIDDEN_TAG]
+        count += 1
+    return count
+
+
+class OriginalsShown:
+    """Context manager: originals the add-on hid are visible inside (the export needs them
+    in the depsgraph), and hidden again on exit."""
+
+    def __init__(self, scene, view_layer):
+        self.scene, self.view_layer = scene, view_layer
+        self.hidden = []
+
+    def __enter__(self):
+        self.hidden = [o.name for o in self.scene.objects if o.get(HIDDEN_TAG)]
+        self.states = {n: self.scene.objects[n][HIDDEN_TAG] for n in self.hidden}
+        try:
+            restore_originals(self.scene, self.view_layer)
+            if self.hidden:
+                self.view_layer.update()
+        except BaseException:  # hide them again: a failed export changes nothing
+            self.__exit__(None, None, None)
+            raise
+        return self
+
+    def __exit__(self, *exc):
+        for name in self.hidden:
+            obj = self.scene.objects.get(name)
+            if obj is None:
+                continue
+            obj[HIDDEN_TAG] = self.states[name]
+            obj.hide_render = True
+            if self.view_layer.objects.get(name) is not None:
+                obj.hide_set(True, view_layer=self.view_layer)
+        return False
+
+
+def show_results(scene, show):
+    """Show or hide the result objects (render and viewport)."""
+    for obj in result_objects(scene):
+        obj.hide_render = not show
+        obj.hide_viewport = not show
+
+
+# --- Toggling and removing ---------------------------------------------------------------
+
+def toggle(scene, view_layer):
+    """Show the originals instead of the result, or the result instead of the originals."""
+    if any(o.get(HIDDEN_TAG) for o in scene.objects):
+        restore_originals(scene, view_layer)
+        show_results(scene, False)
+    else:
+        sources = {o[RESULT_TAG] for o in result_objects(scene)}
+        hide_originals(scene, view_layer, sorted(sources))
+        show_results(scene, True)
+
+
+def clear(scene, view_layer):
+    """Delete the result objects and their collection if it is left empty, and
+    show the originals again (the attributes on originals: bake.remove_original_attributes)."""
+    remove_results(scene)
+    coll = result_collection(scene, create=False)
+    if coll is not None and not coll.all_objects:
+        bpy.data.collections.remove(coll)
+    restore_originals(scene, view_layer)
