@@ -26,7 +26,7 @@ if "bpy" in locals():
 
     for _name in ("native", "compat", "arrays", "light_units", "surface_uv", "bake_materials", "result_state",
                   "export", "bake", "scene_transaction", "display_colours", "game_export", "properties",
-                  "operators", "ui"):
+                  "pipeline", "operators", "ui"):
         if _name in locals():
             importlib.reload(locals()[_name])
 

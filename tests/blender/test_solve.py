@@ -18,7 +18,7 @@ import unittest
 import bpy
 import numpy as np
 
-from radiosity import bake, native, operators, result_state
+from radiosity import bake, native, operators, pipeline, result_state
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "scenes")))
 import build_scene  # noqa: E402
@@ -274,12 +274,12 @@ class DoubledWallTest(unittest.TestCase):
 
 class VisibilityHintTest(unittest.TestCase):
     def test_slow_exact_linking_suggests_sampled_visibility(self):
-        hint = operators.visibility_hint("exact", {"seconds_linking": 42.0})
+        hint = pipeline.visibility_hint("exact", {"seconds_linking": 42.0})
         self.assertIn("Sampled", hint)
         self.assertIn("42 s", hint)
-        self.assertEqual(operators.visibility_hint("exact", {"seconds_linking": 2.0}), "")
-        self.assertEqual(operators.visibility_hint("sampled", {"seconds_linking": 42.0}), "")
-        self.assertEqual(operators.visibility_hint("exact", {}), "")
+        self.assertEqual(pipeline.visibility_hint("exact", {"seconds_linking": 2.0}), "")
+        self.assertEqual(pipeline.visibility_hint("sampled", {"seconds_linking": 42.0}), "")
+        self.assertEqual(pipeline.visibility_hint("exact", {}), "")
 
 
 class FailureTest(unittest.TestCase):
@@ -332,11 +332,8 @@ class FailureTest(unittest.TestCase):
 
 class Reports:
     """Stand-in for the operator: collects reports, runs the operator's methods."""
-    _prepare = operators.RADIOSITY_OT_solve._prepare
     _conclude = operators.RADIOSITY_OT_solve._conclude
-    _finish = operators.RADIOSITY_OT_solve._finish
     _unexpected = operators.RADIOSITY_OT_solve._unexpected
-    _work = staticmethod(operators.RADIOSITY_OT_solve._work)
 
     def __init__(self):
         self.reports = []
@@ -354,7 +351,7 @@ class CancelTest(unittest.TestCase):
         self.before = scene_snapshot(scene)
         solver = native.load()
         op = Reports()
-        job = op._prepare(bpy.context, solver)
+        job = pipeline.prepare(bpy.context, solver)
         token = solver.CancelToken()
         seen = []
 

@@ -20,11 +20,11 @@ import unittest
 import bpy
 import numpy as np
 
-from radiosity import bake, bake_materials, export, native, operators, result_state
+from radiosity import bake, bake_materials, export, native, operators, pipeline, result_state
 from test_addon import scene_snapshot
 from test_solve import open_scene
 
-# The steps each output mode takes after the native solve (operators.py, _finish),
+# The steps each output mode takes after the native solve (pipeline.py, finish),
 # as (module, function).
 STEPS = {
     'REFINED': ((bake, "write_refined"), (result_state, "hide_originals"), (result_state, "show_results"),
@@ -247,11 +247,10 @@ class FailingStepsChangeNothing(unittest.TestCase):
                 before = full_state(scene)
                 solver = native.load()
                 op = Reports()
-                op._finish = lambda context, job: operators.RADIOSITY_OT_solve._finish(op, context, job)
-                job = operators.RADIOSITY_OT_solve._prepare(op, bpy.context, solver)
+                job = pipeline.prepare(bpy.context, solver)
                 token = solver.CancelToken()
                 token.cancel()
-                worker = threading.Thread(target=operators.RADIOSITY_OT_solve._work, args=(solver, job, token))
+                worker = threading.Thread(target=pipeline.work, args=(solver, job, token))
                 worker.start()
                 worker.join(120)
                 self.assertFalse(worker.is_alive())
