@@ -24,9 +24,9 @@ if "bpy" in locals():
     # Re-running register after F8 / "Reload Scripts": pick up edited modules.
     import importlib
 
-    for _name in ("native", "compat", "geometry", "light_units", "surface_uv", "export",
-                  "bake_materials", "bake", "result_state", "display_colours", "game_export", "properties",
-                  "operators", "ui"):
+    for _name in ("native", "compat", "arrays", "light_units", "surface_uv", "bake_materials", "result_state",
+                  "export", "bake", "scene_transaction", "display_colours", "game_export", "properties",
+                  "pipeline", "operators", "ui"):
         if _name in locals():
             importlib.reload(locals()[_name])
 

@@ -1,4 +1,4 @@
-"""Writes a solution into the Blender scene (Blender glue; the array work is geometry.py).
+"""Writes a solution into the Blender scene (Blender glue; the array work is arrays.py).
 
 - Refined output: one mesh object per exported part (object instance or area
   light) in the "Radiosity" collection, carrying the adaptive refinement, with
@@ -8,7 +8,7 @@
   face transparent: the two sides of a two-sided face are two coincident
   polygons facing away from each other, and each is seen only from its side.
   A re-solve replaces them; the originals are never edited, only hidden in
-  renders and viewport while the result is shown (reversibly, `restore_originals`).
+  renders and viewport while the result is shown (reversibly: result_state.py).
 - Lighting-only output (bake_materials.py): the refined objects with copies of
   their originals' materials, lit by the attribute "Radiosity Light" (H, the
   light before reflectance), which every refined mesh carries, with the
@@ -17,21 +17,14 @@
   sampled from the solution at their corners, without refinement.
 """
 
-import json
-
 import bpy
 import numpy as np
 
-from . import bake_materials, compat, geometry, surface_uv
-from .export import HIDDEN_TAG, RESULT_TAG
+from . import arrays, bake_materials, compat, result_state, surface_uv
+from .result_state import MATERIAL_TAG, ORIGINAL_ATTRIBUTE_TAG, RESULT_TAG
 
-COLLECTION_NAME = "Radiosity"
 MATERIAL_NAME = "Radiosity Emission"
 ATTRIBUTE = "Radiosity"
-# On an original mesh whose "Radiosity" attribute the add-on wrote: one of the
-# user's own by that name is never overwritten or removed.
-ORIGINAL_ATTRIBUTE_TAG = "radiosity_attribute"
-MATERIAL_TAG = "radiosity_material"
 # Each side's polygons move this fraction of the scene's size towards the side
 # they show (4 um in a 2 m room), so the two sides of a face never coincide;
 # less than any gap contact.h models (a lamp 0.1 mm above a table top must
@@ -39,35 +32,7 @@ MATERIAL_TAG = "radiosity_material"
 SIDE_OFFSET = 2e-6
 
 
-# --- The Radiosity collection ----------------------------------------------------------
-
-def result_collection(scene, create=True):
-    """The scene's collection of result objects (made on demand)."""
-    for coll in scene.collection.children_recursive:
-        if coll.get(RESULT_TAG):
-            return coll
-    if not create:
-        return None
-    coll = bpy.data.collections.new(COLLECTION_NAME)
-    coll[RESULT_TAG] = True
-    scene.collection.children.link(coll)
-    return coll
-
-
-def result_objects(scene):
-    """The result objects of `scene`."""
-    return [o for o in scene.objects if o.get(RESULT_TAG)]
-
-
-def remove_results(scene):
-    """Delete the result objects and their meshes; keep the (emptied) collection."""
-    for obj in result_objects(scene):
-        mesh = obj.data
-        bpy.data.objects.remove(obj)
-        if mesh is not None and mesh.users == 0:
-            bpy.data.meshes.remove(mesh)
-    bake_materials.remove_unused()
-
+# --- The Radiosity Emission material -----------------------------------------------------
 
 def emission_material():
     """The shared material that shows the "Radiosity" attribute as emitted radiance."""
@@ -148,17 +113,17 @@ def write_refined(scene, exported, result, show_wireframe=False, convert=None, m
     replaces "Radiosity Emission" (game-ready colours: game_export.bake_options).
     `lighting`: with lighting copies of the originals' materials (bake_materials.py)
     instead (the copies of lights' parts keep `material`). `replace_previous(scene)` takes
-    the previous result away (default remove_results; a SceneTransaction retires it)."""
+    the previous result away (default result_state.remove_results; a SceneTransaction retires it)."""
     face_part = exported.arrays["face_part"]
     polygon_part = face_part[np.asarray(result.source_face, dtype=np.int64)]
-    pieces = geometry.split_result(result.face_vertices, result.face_sizes, polygon_part,
-                                   len(exported.parts))
+    pieces = arrays.split_result(result.face_vertices, result.face_sizes, polygon_part,
+                                 len(exported.parts))
     face_sizes = np.asarray(result.face_sizes)
     positions = unmoved = np.asarray(result.positions)
     if len(positions):
         extent = float(np.ptp(positions, axis=0).max())
-        positions = geometry.offset_sides(positions, result.face_vertices, face_sizes,
-                                          SIDE_OFFSET * extent)
+        positions = arrays.offset_sides(positions, result.face_vertices, face_sizes,
+                                        SIDE_OFFSET * extent)
     radiance = np.asarray(result.radiance)
     if convert is not None:
         radiance = convert(radiance)
@@ -198,8 +163,8 @@ def write_refined(scene, exported, result, show_wireframe=False, convert=None, m
             bpy.data.meshes.remove(mesh)
         bake_materials.remove_unused()
         raise
-    (replace_previous or remove_results)(scene)
-    coll = result_collection(scene)
+    (replace_previous or result_state.remove_results)(scene)
+    coll = result_state.result_collection(scene)
     for obj in new_objects:
         coll.objects.link(obj)
         # Made while the old results still held the names: take them back (a user's
@@ -212,7 +177,7 @@ def write_refined(scene, exported, result, show_wireframe=False, convert=None, m
 
 
 def set_wireframe(scene, show):
-    for obj in result_objects(scene):
+    for obj in result_state.result_objects(scene):
         obj.show_wire = show
         obj.show_all_edges = True
 
@@ -228,8 +193,8 @@ def write_original(scene, exported, result, convert=None):
     have no "Radiosity" attribute of the user's own. Returns (object name,
     reason) of those skipped.
     """
-    arrays = exported.arrays
-    extent = float(np.ptp(arrays["positions"], axis=0).max()) if len(arrays["positions"]) else 1.0
+    positions = exported.arrays["positions"]
+    extent = float(np.ptp(positions, axis=0).max()) if len(positions) else 1.0
     skipped = []
     starts = np.cumsum([p.face_count for p in exported.parts]) - [p.face_count for p in exported.parts]
     targets = []
@@ -253,9 +218,9 @@ def write_original(scene, exported, result, convert=None):
     points = np.concatenate([t[0].corner_points for t in targets])
     sizes = np.concatenate([t[0].face_sizes for t in targets])
     ids = np.concatenate([np.arange(t[1], t[1] + t[0].face_count) for t in targets])
-    values, _ = geometry.corner_values(points, sizes, ids, result.positions, result.face_vertices,
-                                       result.face_sizes, result.source_face, result.source_side,
-                                       result.radiance, tolerance=1e-7 * max(extent, 1e-9))
+    values, _ = arrays.corner_values(points, sizes, ids, result.positions, result.face_vertices,
+                                     result.face_sizes, result.source_face, result.source_side,
+                                     result.radiance, tolerance=1e-7 * max(extent, 1e-9))
     if convert is not None:
         values = convert(values)
     offset = 0
@@ -268,9 +233,9 @@ def write_original(scene, exported, result, convert=None):
         loop_total = _loop_total(mesh)
         if part.polygons is not None:   # faces left out of the solve stay black
             loop_start, loop_total = loop_start[part.polygons], loop_total[part.polygons]
-        loops = geometry.polygon_corners(loop_start, loop_total, np.arange(len(mesh.loops)))
+        loops = arrays.polygon_corners(loop_start, loop_total, np.arange(len(mesh.loops)))
         if np.linalg.det(np.array(obj.matrix_world)[:3, :3]) < 0:
-            loops = geometry.reverse_polygons(loops, loop_total)
+            loops = arrays.reverse_polygons(loops, loop_total)
         per_loop = np.zeros((len(mesh.loops), 3), dtype=np.float32)
         per_loop[loops] = part_values
         set_colour_attribute(mesh, per_loop, 'CORNER')
@@ -294,76 +259,7 @@ def remove_original_attributes(scene):
             del obj.data[ORIGINAL_ATTRIBUTE_TAG]
 
 
-# --- Showing the result instead of the originals -----------------------------------------
-
-def hide_originals(scene, view_layer, names):
-    """Hide the named originals in renders and the viewport, remembering their state."""
-    for name in names:
-        obj = scene.objects.get(name)
-        if obj is None or obj.get(HIDDEN_TAG):
-            continue
-        in_layer = view_layer.objects.get(name) is not None
-        obj[HIDDEN_TAG] = json.dumps({"hide_render": obj.hide_render,
-                                      "hidden": obj.hide_get(view_layer=view_layer) if in_layer else False})
-        obj.hide_render = True
-        if in_layer:
-            obj.hide_set(True, view_layer=view_layer)
-
-
-def restore_originals(scene, view_layer):
-    """Undo hide_originals. Returns how many objects were restored."""
-    count = 0
-    for obj in scene.objects:
-        state = obj.get(HIDDEN_TAG)
-        if not state:
-            continue
-        state = json.loads(state)
-        obj.hide_render = state["hide_render"]
-        if view_layer.objects.get(obj.name) is not None:
-            obj.hide_set(state["hidden"], view_layer=view_layer)
-        del obj[HIDDEN_TAG]
-        count += 1
-    return count
-
-
-class OriginalsShown:
-    """Context manager: originals the add-on hid are visible inside (the export needs them
-    in the depsgraph), and hidden again on exit."""
-
-    def __init__(self, scene, view_layer):
-        self.scene, self.view_layer = scene, view_layer
-        self.hidden = []
-
-    def __enter__(self):
-        self.hidden = [o.name for o in self.scene.objects if o.get(HIDDEN_TAG)]
-        self.states = {n: self.scene.objects[n][HIDDEN_TAG] for n in self.hidden}
-        try:
-            restore_originals(self.scene, self.view_layer)
-            if self.hidden:
-                self.view_layer.update()
-        except BaseException:  # hide them again: a failed export changes nothing
-            self.__exit__(None, None, None)
-            raise
-        return self
-
-    def __exit__(self, *exc):
-        for name in self.hidden:
-            obj = self.scene.objects.get(name)
-            if obj is None:
-                continue
-            obj[HIDDEN_TAG] = self.states[name]
-            obj.hide_render = True
-            if self.view_layer.objects.get(name) is not None:
-                obj.hide_set(True, view_layer=self.view_layer)
-        return False
-
-
-def show_results(scene, show):
-    """Show or hide the result objects (render and viewport)."""
-    for obj in result_objects(scene):
-        obj.hide_render = not show
-        obj.hide_viewport = not show
-
+# --- The 3D views ------------------------------------------------------------------------
 
 def set_viewport_attribute_colour():
     """Solid shading shows colour attributes in every 3D view that exists."""

@@ -3,7 +3,7 @@
 Each difference is detected by feature (does the socket or property exist, is it
 writable), so a Blender between or after the tested ones (3.4, 4.5, 5.0) takes the
 path its API has. Only the area light's power-to-radiance factor goes by version,
-since nothing in the API tells it (geometry.area_light_factor).
+since nothing in the API tells it (arrays.area_light_factor).
 """
 
 import bpy

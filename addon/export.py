@@ -1,4 +1,4 @@
-"""Reads a Blender scene into the solver's arrays (Blender glue; the array work is geometry.py).
+"""Reads a Blender scene into the solver's arrays (Blender glue; the array work is arrays.py).
 
 What is exported, as a Cycles render would see it:
 - every mesh-like object a render shows (render_visibility.py: viewport-hidden
@@ -14,7 +14,7 @@ What is exported, as a Cycles render would see it:
   renders it), for the UV maps of the refined result (surface_uv.py);
 - area lights as one-sided emitting polygons (rectangle, square, disk, ellipse)
   that cast no shadow (Cycles lets light through a light object: measured)
-  with Blender's power-to-radiance conversion (geometry.area_light_radiance);
+  with Blender's power-to-radiance conversion (arrays.area_light_radiance);
 - point, spot and sun lights as the solver's direct lights, and a uniform world
   colour (Background colour x strength) as the world's radiance, each with
   Blender's conventions measured in Cycles (light_units.py).
@@ -32,12 +32,8 @@ from dataclasses import dataclass, field
 import bpy
 import numpy as np
 
-from . import compat, geometry, light_units, render_visibility, surface_uv
-
-# Objects the add-on itself made, which must never be solved again.
-RESULT_TAG = "radiosity_result"
-# Originals the add-on hid in renders, with their previous state (bake.py).
-HIDDEN_TAG = "radiosity_hidden"
+from . import arrays, compat, light_units, render_visibility, surface_uv
+from .result_state import HIDDEN_TAG, RESULT_TAG
 
 GEOMETRY_TYPES = {'MESH', 'CURVE', 'SURFACE', 'FONT', 'META'}
 DEFAULT_REFLECTANCE = (0.8, 0.8, 0.8)  # a face without material renders as grey 0.8 diffuse
@@ -216,7 +212,7 @@ def _image_average(image):
         return None
     # Byte images hold their colour space's encoded values; float ones are linear.
     if not image.is_float and image.colorspace_settings.name == 'sRGB':
-        rgb = geometry.srgb_to_linear(rgb)
+        rgb = arrays.srgb_to_linear(rgb)
     return rgb.mean(axis=0)
 
 
@@ -269,7 +265,7 @@ def _mesh_arrays(obj_eval):
         uvs = _mesh_uvs(mesh, loop_start, loop_total)
     finally:
         obj_eval.to_mesh_clear()
-    corners = geometry.polygon_corners(loop_start, loop_total, loop_vertex)
+    corners = arrays.polygon_corners(loop_start, loop_total, loop_vertex)
     return positions.reshape(-1, 3), corners, loop_total.astype(np.int64), material_index, uvs
 
 
@@ -309,7 +305,7 @@ def export_scene(context, blender_version=None):
     # Cycles leaves out what is disabled in renders, itself or by a collection.
     rendered = render_visibility.rendered_objects(context.view_layer, _renderable)
     version = tuple(blender_version or bpy.app.version)
-    builder = geometry.SceneBuilder()
+    builder = arrays.SceneBuilder()
     reader = MaterialReader()
     parts = []
     lights_not_modelled = {}
@@ -330,7 +326,7 @@ def export_scene(context, blender_version=None):
         matrix = np.array(inst.matrix_world, dtype=float)
         if obj.type == 'LIGHT':
             light = obj.data
-            if not geometry.finite(matrix).all():
+            if not arrays.finite(matrix).all():
                 non_finite[owner.name] = None
                 continue
             if light.type != 'AREA':
@@ -343,17 +339,17 @@ def export_scene(context, blender_version=None):
                 if light.use_nodes:
                     light_notes.add("light node setups")
                 continue
-            local, area = geometry.area_light_polygon(light.shape, light.size, light.size_y)
-            area = geometry.scaled_area(matrix, area)
+            local, area = arrays.area_light_polygon(light.shape, light.size, light.size_y)
+            area = arrays.scaled_area(matrix, area)
             if area <= 0.0 or light.energy <= 0.0:
                 continue
-            radiance = geometry.area_light_radiance(version, light.energy, area, compat.light_colour(light),
-                                                   compat.light_exposure(light), compat.light_normalized(light))
+            radiance = arrays.area_light_radiance(version, light.energy, area, compat.light_colour(light),
+                                                  compat.light_exposure(light), compat.light_normalized(light))
             if getattr(light, "spread", math.pi) < math.pi - 1e-6:
                 light_notes.add("area light spread")
             if light.use_nodes:
                 light_notes.add("light node setups")
-            points = geometry.transform_points(local, matrix)
+            points = arrays.transform_points(local, matrix)
             n = len(points)
             builder.add(points, np.arange(n), [n], [0.0, 0.0, 0.0], radiance, False, occludes=False)
             part = Part(name=_unique(names_used, original.name), source=owner.name,
@@ -368,22 +364,22 @@ def export_scene(context, blender_version=None):
         if len(sizes) == 0:
             continue
         with np.errstate(invalid="ignore", over="ignore"):   # NaN and Inf are dealt with below
-            world = geometry.transform_points(positions, matrix)
+            world = arrays.transform_points(positions, matrix)
         # An Inf (a float's largest) rotated may come out finite: local coordinates count too.
-        world[~geometry.finite(positions).all(axis=1)] = np.nan
+        world[~arrays.finite(positions).all(axis=1)] = np.nan
         mirrored = np.linalg.det(matrix[:3, :3]) < 0
         if mirrored:
             # A mirroring transform flips the winding; keep normals as Blender shows them.
-            corners = geometry.reverse_polygons(corners, sizes)
+            corners = arrays.reverse_polygons(corners, sizes)
         name = original.name if not inst.is_instance else "%s (%s)" % (original.name, owner.name)
         # The solver refuses non-finite coordinates: faces using one are left out, and named.
-        keep = geometry.finite_faces(world, corners, sizes)
+        keep = arrays.finite_faces(world, corners, sizes)
         polygon_count, polygons, corner_keep = len(sizes), None, None
         if not keep.all():
             non_finite[name] = (int(np.count_nonzero(~keep)), polygon_count)
             if not keep.any():
                 continue
-            world, corners, sizes, corner_keep = geometry.keep_faces(world, corners, sizes, keep)
+            world, corners, sizes, corner_keep = arrays.keep_faces(world, corners, sizes, keep)
             polygons, material_index = np.flatnonzero(keep), material_index[keep]
         materials = [slot.material for slot in obj.material_slots] or [None]
         table = [reader.read(m) for m in materials]

@@ -47,7 +47,7 @@ from bpy.props import StringProperty
 from bpy.types import Operator
 from bpy_extras.io_utils import ExportHelper
 
-from . import bake, display_colours
+from . import bake, display_colours, result_state
 
 UNLIT_MATERIAL_NAME = "Radiosity Unlit"
 UNLIT_TAG = "radiosity_unlit_material"
@@ -214,7 +214,7 @@ def export_gltf(context, filepath):
     scene, view_layer = context.scene, context.view_layer
     if os.path.splitext(filepath)[1].lower() not in (".glb", ".gltf"):
         filepath += ".glb"
-    objects = [o for o in bake.result_objects(scene) if view_layer.objects.get(o.name) is not None]
+    objects = [o for o in result_state.result_objects(scene) if view_layer.objects.get(o.name) is not None]
     if not objects:
         raise RuntimeError("No radiosity result to export: solve with output Refined Meshes first")
     not_ready = [o.name for o in objects if not is_game_ready(o)]
@@ -268,7 +268,7 @@ class RADIOSITY_OT_export_gltf(Operator, ExportHelper):
 
     @classmethod
     def poll(cls, context):
-        return context.scene is not None and bool(bake.result_objects(context.scene))
+        return context.scene is not None and bool(result_state.result_objects(context.scene))
 
     def execute(self, context):
         try:

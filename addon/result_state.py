@@ -1,148 +1,151 @@
-"""Writing a solve into the scene as one transaction.
+"""The radiosity result's state in the scene: what is the result, what it hides.
 
-A solve changes the scene in several steps: it replaces the result objects
-(and their lighting copies of materials), hides the originals, writes the
-"Radiosity" attribute onto original meshes and switches the 3D views to
-attribute colours. Any step can fail (a bug, a full memory, an object Blender
-refuses to change); the user must then find the scene exactly as it was, the
-previous result included. `SceneTransaction` records what the steps touch;
-on an exception it puts every bit of it back, on success it deletes the
-previous result for good.
+A solve leaves its marks in the scene as custom properties (the tags below,
+defined only here): the result objects and their "Radiosity" collection, the
+originals hidden while the result is shown (with their state before, to be put
+back), the shared "Radiosity Emission" material and the attributes written on
+original meshes. Finding the result, hiding and restoring the originals,
+toggling between the two and removing the result read these marks. Writing
+the result is bake.py; a solve's rollback is scene_transaction.py.
 """
+
+import json
 
 import bpy
 
-from . import bake, bake_materials, compat
-from .export import HIDDEN_TAG, RESULT_TAG
+from . import bake_materials
 
-RETIRED_SUFFIX = " (previous radiosity result)"
+# Objects the add-on itself made, which must never be solved again.
+RESULT_TAG = "radiosity_result"
+# Originals the add-on hid in renders, with their previous state (hide_originals).
+HIDDEN_TAG = "radiosity_hidden"
+# On an original mesh whose "Radiosity" attribute the add-on wrote: one of the
+# user's own by that name is never overwritten or removed.
+ORIGINAL_ATTRIBUTE_TAG = "radiosity_attribute"
+# The shared "Radiosity Emission" material (bake.emission_material).
+MATERIAL_TAG = "radiosity_material"
+COLLECTION_NAME = "Radiosity"
 
 
-def _views():
-    for screen in bpy.data.screens:
-        for area in screen.areas:
-            for space in area.spaces:
-                if space.type == 'VIEW_3D':
-                    yield space
+# --- The Radiosity collection ------------------------------------------------------------
+
+def result_collection(scene, create=True):
+    """The scene's collection of result objects (made on demand)."""
+    for coll in scene.collection.children_recursive:
+        if coll.get(RESULT_TAG):
+            return coll
+    if not create:
+        return None
+    coll = bpy.data.collections.new(COLLECTION_NAME)
+    coll[RESULT_TAG] = True
+    scene.collection.children.link(coll)
+    return coll
 
 
-class SceneTransaction:
-    """with SceneTransaction(scene, view_layer) as t: ... t.retire_results() ...
+def result_objects(scene):
+    """The result objects of `scene`."""
+    return [o for o in scene.objects if o.get(RESULT_TAG)]
 
-    Inside, the previous result objects are only retired (unlinked, renamed,
-    kept in bpy.data) so the new ones can take their names."""
+
+def remove_results(scene):
+    """Delete the result objects and their meshes; keep the (emptied) collection."""
+    for obj in result_objects(scene):
+        mesh = obj.data
+        bpy.data.objects.remove(obj)
+        if mesh is not None and mesh.users == 0:
+            bpy.data.meshes.remove(mesh)
+    bake_materials.remove_unused()
+
+
+# --- Showing the result instead of the originals -----------------------------------------
+
+def hide_originals(scene, view_layer, names):
+    """Hide the named originals in renders and the viewport, remembering their state."""
+    for name in names:
+        obj = scene.objects.get(name)
+        if obj is None or obj.get(HIDDEN_TAG):
+            continue
+        in_layer = view_layer.objects.get(name) is not None
+        obj[HIDDEN_TAG] = json.dumps({"hide_render": obj.hide_render,
+                                      "hidden": obj.hide_get(view_layer=view_layer) if in_layer else False})
+        obj.hide_render = True
+        if in_layer:
+            obj.hide_set(True, view_layer=view_layer)
+
+
+def restore_originals(scene, view_layer):
+    """Undo hide_originals. Returns how many objects were restored."""
+    count = 0
+    for obj in scene.objects:
+        state = obj.get(HIDDEN_TAG)
+        if not state:
+            continue
+        state = json.loads(state)
+        obj.hide_render = state["hide_render"]
+        if view_layer.objects.get(obj.name) is not None:
+            obj.hide_set(state["hidden"], view_layer=view_layer)
+        del obj[HIDDEN_TAG]
+        count += 1
+    return count
+
+
+class OriginalsShown:
+    """Context manager: originals the add-on hid are visible inside (the export needs them
+    in the depsgraph), and hidden again on exit."""
 
     def __init__(self, scene, view_layer):
         self.scene, self.view_layer = scene, view_layer
-        self.retired = []  # (object, name, mesh name)
-        self.retired_materials = []  # (material, name)
+        self.hidden = []
 
     def __enter__(self):
-        scene, layer = self.scene, self.view_layer
-        self.had_collection = bake.result_collection(scene, create=False) is not None
-        self.objects = set(bpy.data.objects)
-        self.meshes = set(bpy.data.meshes)
-        self.materials = set(bpy.data.materials)
-        self.visibility = {}
-        for obj in scene.objects:
-            in_layer = layer.objects.get(obj.name) is not None
-            self.visibility[obj] = (obj.hide_render, obj.hide_viewport, obj.get(HIDDEN_TAG),
-                                    obj.hide_get(view_layer=layer) if in_layer else None)
-        self.attributes = {}
-        for obj in scene.objects:
-            if obj.type == 'MESH' and not obj.get(RESULT_TAG) and obj.data not in self.attributes:
-                attr = obj.data.color_attributes.get(bake.ATTRIBUTE)
-                self.attributes[obj.data] = (None if attr is None else _copy_attribute(attr),
-                                             obj.data.get(bake.ORIGINAL_ATTRIBUTE_TAG))
-        self.shading = [(space, space.shading.color_type) for space in _views()]
+        self.hidden = [o.name for o in self.scene.objects if o.get(HIDDEN_TAG)]
+        self.states = {n: self.scene.objects[n][HIDDEN_TAG] for n in self.hidden}
+        try:
+            restore_originals(self.scene, self.view_layer)
+            if self.hidden:
+                self.view_layer.update()
+        except BaseException:  # hide them again: a failed export changes nothing
+            self.__exit__(None, None, None)
+            raise
         return self
 
-    def retire_results(self):
-        """Take the previous result objects out of the scene, keeping them for a rollback."""
-        coll = bake.result_collection(self.scene, create=False)
-        if coll is None:
-            return
-        for obj in list(coll.objects):
-            if not obj.get(RESULT_TAG):
+    def __exit__(self, *exc):
+        for name in self.hidden:
+            obj = self.scene.objects.get(name)
+            if obj is None:
                 continue
-            self.retired.append((obj, obj.name, obj.data.name if obj.data is not None else None))
-            for slot in obj.material_slots:
-                m = slot.material
-                if m is not None and m.get(bake_materials.COPY_TAG) is not None and \
-                        all(m is not r for r, _ in self.retired_materials):
-                    self.retired_materials.append((m, m.name))
-            coll.objects.unlink(obj)
-        # Free the names for the new result (lighting copies included); set_name,
-        # since a user's object may already carry a retired name.
-        for obj, name, mesh_name in self.retired:
-            compat.set_name(bpy.data.objects, obj, name + RETIRED_SUFFIX)
-            if obj.data is not None:
-                compat.set_name(bpy.data.meshes, obj.data, mesh_name + RETIRED_SUFFIX)
-        for material, name in self.retired_materials:
-            compat.set_name(bpy.data.materials, material, name + RETIRED_SUFFIX)
-
-    def __exit__(self, kind, error, trace):
-        if kind is None:
-            self._commit()
-        else:
-            self._rollback()
+            obj[HIDDEN_TAG] = self.states[name]
+            obj.hide_render = True
+            if self.view_layer.objects.get(name) is not None:
+                obj.hide_set(True, view_layer=self.view_layer)
         return False
 
-    def _commit(self):
-        for obj, _, _ in self.retired:
-            mesh = obj.data
-            bpy.data.objects.remove(obj)
-            if mesh is not None and mesh.users == 0:
-                bpy.data.meshes.remove(mesh)
-        bake_materials.remove_unused()
 
-    def _rollback(self):
-        # What the failed steps made goes first, so that the old names are free.
-        for obj in [o for o in bpy.data.objects if o not in self.objects]:
-            bpy.data.objects.remove(obj)
-        for mesh in [m for m in bpy.data.meshes if m not in self.meshes and m.users == 0]:
-            bpy.data.meshes.remove(mesh)
-        for material in [m for m in bpy.data.materials if m not in self.materials and m.users == 0]:
-            bpy.data.materials.remove(material)
-        for material, name in self.retired_materials:
-            compat.set_name(bpy.data.materials, material, name)
-        coll = bake.result_collection(self.scene, create=not self.had_collection and bool(self.retired))
-        for obj, name, mesh_name in self.retired:
-            compat.set_name(bpy.data.objects, obj, name)
-            if obj.data is not None:
-                compat.set_name(bpy.data.meshes, obj.data, mesh_name)
-            if coll is not None and obj.name not in coll.objects:
-                coll.objects.link(obj)
-        if not self.had_collection and coll is not None and not self.retired and len(coll.objects) == 0:
-            bpy.data.collections.remove(coll)
-        layer = self.view_layer
-        for obj, (hide_render, hide_viewport, tag, hidden) in self.visibility.items():
-            obj.hide_render, obj.hide_viewport = hide_render, hide_viewport
-            if tag is None:
-                if HIDDEN_TAG in obj:
-                    del obj[HIDDEN_TAG]
-            else:
-                obj[HIDDEN_TAG] = tag
-            if hidden is not None and layer.objects.get(obj.name) is not None:
-                obj.hide_set(hidden, view_layer=layer)
-        for mesh, (saved, tag) in self.attributes.items():
-            if tag is None:
-                mesh.pop(bake.ORIGINAL_ATTRIBUTE_TAG, None)
-            else:
-                mesh[bake.ORIGINAL_ATTRIBUTE_TAG] = tag
-            attrs = mesh.color_attributes
-            current = attrs.get(bake.ATTRIBUTE)
-            if current is not None:
-                attrs.remove(current)
-            if saved is not None:
-                data_type, domain, values = saved
-                attr = attrs.new(bake.ATTRIBUTE, data_type, domain)
-                attr.data.foreach_set("color", values)
-        for space, colour in self.shading:
-            space.shading.color_type = colour
+def show_results(scene, show):
+    """Show or hide the result objects (render and viewport)."""
+    for obj in result_objects(scene):
+        obj.hide_render = not show
+        obj.hide_viewport = not show
 
 
-def _copy_attribute(attr):
-    values = [0.0] * (4 * len(attr.data))
-    attr.data.foreach_get("color", values)
-    return attr.data_type, attr.domain, values
+# --- Toggling and removing ---------------------------------------------------------------
+
+def toggle(scene, view_layer):
+    """Show the originals instead of the result, or the result instead of the originals."""
+    if any(o.get(HIDDEN_TAG) for o in scene.objects):
+        restore_originals(scene, view_layer)
+        show_results(scene, False)
+    else:
+        sources = {o[RESULT_TAG] for o in result_objects(scene)}
+        hide_originals(scene, view_layer, sorted(sources))
+        show_results(scene, True)
+
+
+def clear(scene, view_layer):
+    """Delete the result objects and their collection if it is left empty, and
+    show the originals again (the attributes on originals: bake.remove_original_attributes)."""
+    remove_results(scene)
+    coll = result_collection(scene, create=False)
+    if coll is not None and not coll.all_objects:
+        bpy.data.collections.remove(coll)
+    restore_originals(scene, view_layer)

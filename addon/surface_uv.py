@@ -155,7 +155,7 @@ def interpolate(face_points, face_sizes, triangles, triangle_face, values, query
 
 def part_corner_queries(face_vertices, face_starts, face_sizes, polygons, source_face, first_face):
     """The corners of result polygons `polygons` (one part's, ascending: the order
-    geometry.split_result builds its mesh in): (result vertex of each corner, the
+    arrays.split_result builds its mesh in): (result vertex of each corner, the
     part's input face of each corner, counted from `first_face`)."""
     polygons = np.asarray(polygons, dtype=np.int64)
     sizes = np.asarray(face_sizes, dtype=np.int64)[polygons]

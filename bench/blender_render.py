@@ -92,12 +92,12 @@ def visible_edges(scene, result, projection):
 
 
 def render_solutions(scene, jobs, exported, projection):
-    from radiosity import bake
+    from radiosity import bake, result_state
     for job in jobs:
         result = load_result(job["npz"])
         bake.write_refined(scene, exported, result)
-        bake.hide_originals(scene, bpy.context.view_layer, exported.hidden_sources)
-        bake.show_results(scene, True)
+        result_state.hide_originals(scene, bpy.context.view_layer, exported.hidden_sources)
+        result_state.show_results(scene, True)
         start = time.perf_counter()
         common.render_to(scene, job["exr"])
         common.say("rendered %s (%d polygons) in %.1f s" % (os.path.basename(job["exr"]), len(result.face_sizes),
@@ -108,7 +108,7 @@ def render_solutions(scene, jobs, exported, projection):
 
 def main():
     jobs = common.start_jobs()
-    from radiosity import bake, export
+    from radiosity import export, result_state
 
     scene = bpy.context.scene
     width, height = jobs["width"], jobs["height"]
@@ -129,7 +129,7 @@ def main():
         common.setup_render(scene, width, height, jobs.get("samples", 16))
         exported = export.export_scene(bpy.context)
         render_solutions(scene, jobs["solutions"], exported, projection)
-        bake.remove_results(scene)
+        result_state.remove_results(scene)
 
 
 if __name__ == "__main__":

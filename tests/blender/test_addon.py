@@ -13,7 +13,7 @@ import addon_utils
 import bpy
 
 import radiosity
-from radiosity import native, operators, properties, ui
+from radiosity import native, operators, pipeline, properties, ui
 from layout_check import CheckedLayout, FakePanel
 
 # Every type the add-on registers, by its base type and RNA name.
@@ -328,8 +328,7 @@ class OperatorTest(unittest.TestCase):
         reports = []
 
         class Stub:
-            _solve = operators.RADIOSITY_OT_solve._solve
-            _prepare = operators.RADIOSITY_OT_solve._prepare
+            _conclude = operators.RADIOSITY_OT_solve._conclude
             _unexpected = operators.RADIOSITY_OT_solve._unexpected
 
             def report(self, kind, message):
@@ -354,15 +353,15 @@ class OperatorTest(unittest.TestCase):
         self.assertIn("native module could not be loaded: test", message)
 
     def test_unexpected_exception_becomes_a_report(self):
-        def broken(self, context, solver, started):
+        def broken(context, solver, started):
             raise ZeroDivisionError("simulated bug")
 
-        saved = operators.RADIOSITY_OT_solve._solve
-        operators.RADIOSITY_OT_solve._solve = broken
+        saved = pipeline.prepare
+        pipeline.prepare = broken
         try:
             message = self.solve_error()
         finally:
-            operators.RADIOSITY_OT_solve._solve = saved
+            pipeline.prepare = saved
         self.assertIn("failed unexpectedly: ZeroDivisionError: simulated bug", message)
 
 

@@ -30,7 +30,7 @@ import bpy
 import numpy as np
 
 import render_compare as rc
-from radiosity import bake
+from radiosity import result_state
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "scenes")))
 import scene_kit as kit  # noqa: E402
@@ -74,7 +74,7 @@ class CyclesAgreementTest(unittest.TestCase):
         reference = rc.render_image(scene, REFERENCE_SAMPLES)
         scene.radiosity.quality = QUALITY
         self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
-        self.assertTrue(bake.result_objects(scene))
+        self.assertTrue(result_state.result_objects(scene))
         solution = rc.render_image(scene, 16)
         folder = os.environ.get("RADIOSITY_TEST_IMAGES")
         if folder:
@@ -113,7 +113,7 @@ class CyclesAgreementTest(unittest.TestCase):
         self.agree(scene, "area_light")
         # The light became a one-sided polygon of radiance P / (4 A) in 3.x, P / (pi A)
         # in 4.x and 5.x (measured: test_light_conversion.py).
-        out = [o for o in bake.result_objects(scene) if o["radiosity_result"] == "Area"][0]
+        out = [o for o in result_state.result_objects(scene) if o["radiosity_result"] == "Area"][0]
         attr = out.data.color_attributes["Radiosity"]
         values = np.empty(4 * len(attr.data), dtype=np.float32)
         attr.data.foreach_get("color", values)

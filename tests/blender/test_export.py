@@ -14,7 +14,7 @@ import unittest
 import bpy
 import numpy as np
 
-from radiosity import export, geometry
+from radiosity import arrays, export, result_state
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "scenes")))
 import scene_kit as kit  # noqa: E402
@@ -180,7 +180,7 @@ class GeometryTest(unittest.TestCase):
         # The array goes along local +x, so world -x after the mirror.
         self.assertLess(a["positions"][:, 0].min(), -4.9)
         # Normals as Blender shows them: a plane's +z stays +z under the mirror.
-        normals = geometry.polygon_normals(a["positions"], a["face_vertices"], a["face_sizes"])
+        normals = arrays.polygon_normals(a["positions"], a["face_vertices"], a["face_sizes"])
         np.testing.assert_allclose(normals, [[0, 0, 1]] * 3, atol=1e-12)
 
     def test_collection_instances(self):
@@ -205,7 +205,7 @@ class GeometryTest(unittest.TestCase):
         scene = new_file()
         plane(scene, "Shown")
         plane(scene, "NotRendered").hide_render = True
-        plane(scene, "Result")[export.RESULT_TAG] = "Shown"
+        plane(scene, "Result")[result_state.RESULT_TAG] = "Shown"
         self.assertEqual([p.name for p in export_now().parts], ["Shown"])
 
 
@@ -232,7 +232,7 @@ class LightTest(unittest.TestCase):
         for i, part in enumerate(ex.parts):
             rows = np.flatnonzero(a["face_part"] == i)
             np.testing.assert_allclose(a["emission"][rows], [[AREA_LIGHT_FACTOR * 100 / areas[part.name]] * 3], rtol=1e-6)   # sizes are float32
-            normal = geometry.polygon_normals(a["positions"], a["face_vertices"][
+            normal = arrays.polygon_normals(a["positions"], a["face_vertices"][
                 np.repeat(a["face_part"], a["face_sizes"]) == i], a["face_sizes"][rows])
             np.testing.assert_allclose(normal, [[0, 1, 0]], atol=1e-6)   # -z turned to +y (float32 matrix)
         # Point, spot and sun lights are the solver's direct lights, not polygons.

@@ -19,7 +19,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from radiosity import bake, display_colours, export, game_export
+from radiosity import bake, display_colours, game_export, result_state
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "scenes")))
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "tools")))
@@ -62,7 +62,7 @@ def solve(scene):
     """Solve; the result objects by the names of their originals."""
     result = bpy.ops.radiosity.solve()
     assert result == {'FINISHED'}, result
-    return {o[export.RESULT_TAG]: o for o in bake.result_objects(scene)}
+    return {o[result_state.RESULT_TAG]: o for o in result_state.result_objects(scene)}
 
 
 # --- Reading a .glb ------------------------------------------------------------------------
@@ -201,7 +201,7 @@ class GltfExportTest(unittest.TestCase):
         scene = open_cube()
         scene.radiosity.display_colours = True
         cls.results = {o.name: o for o in solve(scene).values()}
-        cls.originals = sorted({o.name for o in scene.objects if not o.get(export.RESULT_TAG)})
+        cls.originals = sorted({o.name for o in scene.objects if not o.get(result_state.RESULT_TAG)})
         # Something selected and active beforehand, to be given back.
         cube = scene.objects["Cube"]
         cube.hide_set(False)

@@ -32,7 +32,7 @@ import numpy as np
 
 import image_agreement
 import render_compare as rc
-from radiosity import bake, bake_materials, compat, export
+from radiosity import bake, bake_materials, compat, export, result_state
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scenes"))
@@ -316,11 +316,11 @@ def originals_snapshot(scene):
     """Everything of the original objects, meshes, materials and images a bake could touch."""
     data = {}
     for obj in scene.objects:
-        if obj.get(export.RESULT_TAG):
+        if obj.get(result_state.RESULT_TAG):
             continue
         entry = {"matrix": [tuple(r) for r in obj.matrix_world], "data": obj.data.name if obj.data else None,
                  "slots": [(s.link, s.material.name if s.material else None) for s in obj.material_slots],
-                 "keys": sorted(k for k in obj.keys() if k != export.HIDDEN_TAG),
+                 "keys": sorted(k for k in obj.keys() if k != result_state.HIDDEN_TAG),
                  "hidden": (obj.hide_render, obj.hide_viewport, obj.hide_get())}
         if obj.type == 'MESH':
             mesh = obj.data
@@ -333,7 +333,7 @@ def originals_snapshot(scene):
                              [m.name if m else None for m in mesh.materials])
         data[obj.name] = entry
     for mat in bpy.data.materials:
-        if mat.get(bake_materials.COPY_TAG) is not None or mat.get(bake.MATERIAL_TAG):
+        if mat.get(bake_materials.COPY_TAG) is not None or mat.get(result_state.MATERIAL_TAG):
             continue
         entry = {"use_nodes": mat.use_nodes, "diffuse": tuple(mat.diffuse_color), "users": mat.users,
                  "keys": sorted(mat.keys()), "backface": mat.use_backface_culling}
@@ -381,7 +381,7 @@ class LightingBakeTest(unittest.TestCase):
 
     @property
     def results(self):
-        return {o[export.RESULT_TAG]: o for o in bake.result_objects(self.scene)}
+        return {o[result_state.RESULT_TAG]: o for o in result_state.result_objects(self.scene)}
 
     def test_solved(self):
         self.assertEqual(self.status, {'FINISHED'})
@@ -462,7 +462,7 @@ class LightingBakeTest(unittest.TestCase):
         scene = self.scene
         self.assertEqual(bpy.ops.radiosity.clear(), {'FINISHED'})
         self.assertEqual(originals_snapshot(scene), self.before)
-        self.assertFalse(bake.result_objects(scene))
+        self.assertFalse(result_state.result_objects(scene))
         self.assertFalse([m.name for m in bpy.data.materials if m.get(bake_materials.COPY_TAG) is not None])
         # Solve again afterwards: the copies come back under their names.
         self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
@@ -542,8 +542,8 @@ class LightAttributeTest(unittest.TestCase):
         self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
         reader = export.MaterialReader()
         checked = 0
-        for obj in bake.result_objects(scene):
-            original = scene.objects[obj[export.RESULT_TAG]]
+        for obj in result_state.result_objects(scene):
+            original = scene.objects[obj[result_state.RESULT_TAG]]
             mesh = obj.data
             light = mesh.color_attributes[bake_materials.LIGHT_ATTRIBUTE]
             self.assertEqual((light.data_type, light.domain), ('FLOAT_COLOR', 'POINT'))

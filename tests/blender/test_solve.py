@@ -18,7 +18,7 @@ import unittest
 import bpy
 import numpy as np
 
-from radiosity import bake, export, native, operators
+from radiosity import bake, native, operators, pipeline, result_state
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "scenes")))
 import build_scene  # noqa: E402
@@ -79,7 +79,7 @@ def values_at(obj, points):
 
 
 def results(scene):
-    return {o[export.RESULT_TAG]: o for o in bake.result_objects(scene)}
+    return {o[result_state.RESULT_TAG]: o for o in result_state.result_objects(scene)}
 
 
 def luminance(rgb):
@@ -113,9 +113,9 @@ class SolveCubeTest(unittest.TestCase):
 
     def check_result(self, scene):
         out = results(scene)
-        meshes = {o.name for o in scene.objects if o.type == 'MESH' and not o.get(export.RESULT_TAG)}
+        meshes = {o.name for o in scene.objects if o.type == 'MESH' and not o.get(result_state.RESULT_TAG)}
         self.assertEqual(set(out), meshes)
-        coll = bake.result_collection(scene, create=False)
+        coll = result_state.result_collection(scene, create=False)
         self.assertEqual(coll.name, "Radiosity")
         for name, obj in out.items():
             self.assertEqual(obj.users_collection[0], coll)
@@ -175,15 +175,15 @@ class SolveCubeTest(unittest.TestCase):
     def test_resolve_replaces_results(self):
         scene = open_scene("cube")
         bpy.ops.radiosity.solve()
-        first = sorted(o.name for o in bake.result_objects(scene))
+        first = sorted(o.name for o in result_state.result_objects(scene))
         mesh_count = len(bpy.data.meshes)
         scene.radiosity.oracle = 'STANDARD'
         bpy.ops.radiosity.solve()
-        second = sorted(o.name for o in bake.result_objects(scene))
+        second = sorted(o.name for o in result_state.result_objects(scene))
         self.assertEqual(first, second)
         self.assertEqual(len(bpy.data.meshes), mesh_count)
-        self.assertEqual(len([c for c in bpy.data.collections if c.get(export.RESULT_TAG)]), 1)
-        self.assertEqual(len([m for m in bpy.data.materials if m.get(bake.MATERIAL_TAG)]), 1)
+        self.assertEqual(len([c for c in bpy.data.collections if c.get(result_state.RESULT_TAG)]), 1)
+        self.assertEqual(len([m for m in bpy.data.materials if m.get(result_state.MATERIAL_TAG)]), 1)
         # Hidden originals are still solved (not dropped because we hid them).
         self.assertEqual(len(second), 8)
 
@@ -193,10 +193,10 @@ class SolveCubeTest(unittest.TestCase):
         bpy.ops.radiosity.solve()
         self.assertEqual(bpy.ops.radiosity.toggle_result(), {'FINISHED'})
         self.assertFalse(scene.objects["Floor"].hide_render)
-        self.assertTrue(all(o.hide_render for o in bake.result_objects(scene)))
+        self.assertTrue(all(o.hide_render for o in result_state.result_objects(scene)))
         bpy.ops.radiosity.toggle_result()
         self.assertTrue(scene.objects["Floor"].hide_render)
-        self.assertFalse(any(o.hide_render for o in bake.result_objects(scene)))
+        self.assertFalse(any(o.hide_render for o in result_state.result_objects(scene)))
         bpy.ops.radiosity.clear()
         after = scene_snapshot(scene)
         # Everything as before but the shared emission material, kept for re-use.
@@ -214,17 +214,17 @@ class SolveCubeTest(unittest.TestCase):
         bpy.ops.ed.undo_push(message="before solve")
         bpy.ops.radiosity.solve()
         bpy.ops.ed.undo_push(message="Solve Radiosity")
-        self.assertTrue(bake.result_objects(bpy.context.scene))
+        self.assertTrue(result_state.result_objects(bpy.context.scene))
         bpy.ops.ed.undo()
         scene = bpy.context.scene
-        self.assertFalse(bake.result_objects(scene))
+        self.assertFalse(result_state.result_objects(scene))
         self.assertEqual(scene_snapshot(scene), before)
 
     def test_original_output(self):
         scene = open_scene("cube")
         scene.radiosity.output = 'ORIGINAL'
         self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
-        self.assertFalse(bake.result_objects(scene))
+        self.assertFalse(result_state.result_objects(scene))
         floor = scene.objects["Floor"]
         self.assertFalse(floor.hide_render)
         attr = floor.data.color_attributes["Radiosity"]
@@ -238,16 +238,16 @@ class SolveCubeTest(unittest.TestCase):
         # BOTH writes both.
         scene.radiosity.output = 'BOTH'
         bpy.ops.radiosity.solve()
-        self.assertTrue(bake.result_objects(scene))
+        self.assertTrue(result_state.result_objects(scene))
         self.assertIn("Radiosity", floor.data.color_attributes)
 
     def test_wireframe_option(self):
         scene = open_scene("cube")
         scene.radiosity.show_wireframe = True
         bpy.ops.radiosity.solve()
-        self.assertTrue(all(o.show_wire for o in bake.result_objects(scene)))
+        self.assertTrue(all(o.show_wire for o in result_state.result_objects(scene)))
         scene.radiosity.show_wireframe = False
-        self.assertFalse(any(o.show_wire for o in bake.result_objects(scene)))
+        self.assertFalse(any(o.show_wire for o in result_state.result_objects(scene)))
 
 
 class DoubledWallTest(unittest.TestCase):
@@ -262,7 +262,7 @@ class DoubledWallTest(unittest.TestCase):
                 copy.name = "Duplicate of wall"
                 scene.collection.objects.link(copy)
             self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
-            values = np.concatenate([attribute(o) for o in bake.result_objects(scene)])
+            values = np.concatenate([attribute(o) for o in result_state.result_objects(scene)])
             return scene.radiosity.stats.warning, luminance(values).mean(), wall.name
 
         single_warning, single, _ = solve(False)
@@ -274,12 +274,12 @@ class DoubledWallTest(unittest.TestCase):
 
 class VisibilityHintTest(unittest.TestCase):
     def test_slow_exact_linking_suggests_sampled_visibility(self):
-        hint = operators.visibility_hint("exact", {"seconds_linking": 42.0})
+        hint = pipeline.visibility_hint("exact", {"seconds_linking": 42.0})
         self.assertIn("Sampled", hint)
         self.assertIn("42 s", hint)
-        self.assertEqual(operators.visibility_hint("exact", {"seconds_linking": 2.0}), "")
-        self.assertEqual(operators.visibility_hint("sampled", {"seconds_linking": 42.0}), "")
-        self.assertEqual(operators.visibility_hint("exact", {}), "")
+        self.assertEqual(pipeline.visibility_hint("exact", {"seconds_linking": 2.0}), "")
+        self.assertEqual(pipeline.visibility_hint("sampled", {"seconds_linking": 42.0}), "")
+        self.assertEqual(pipeline.visibility_hint("exact", {}), "")
 
 
 class FailureTest(unittest.TestCase):
@@ -332,11 +332,8 @@ class FailureTest(unittest.TestCase):
 
 class Reports:
     """Stand-in for the operator: collects reports, runs the operator's methods."""
-    _prepare = operators.RADIOSITY_OT_solve._prepare
     _conclude = operators.RADIOSITY_OT_solve._conclude
-    _finish = operators.RADIOSITY_OT_solve._finish
     _unexpected = operators.RADIOSITY_OT_solve._unexpected
-    _work = staticmethod(operators.RADIOSITY_OT_solve._work)
 
     def __init__(self):
         self.reports = []
@@ -354,7 +351,7 @@ class CancelTest(unittest.TestCase):
         self.before = scene_snapshot(scene)
         solver = native.load()
         op = Reports()
-        job = op._prepare(bpy.context, solver)
+        job = pipeline.prepare(bpy.context, solver)
         token = solver.CancelToken()
         seen = []
 
@@ -385,10 +382,10 @@ class CancelTest(unittest.TestCase):
         self.assertTrue(job.result.stats["cancelled"])
         self.assertEqual(scene.radiosity.stats.status, "Cancelled (last complete pass kept)")
         self.assertTrue(seen)
-        for obj in bake.result_objects(scene):
+        for obj in result_state.result_objects(scene):
             values = attribute(obj)
             self.assertTrue(np.all(np.isfinite(values)))
-        self.assertEqual(len(bake.result_objects(scene)), 8)
+        self.assertEqual(len(result_state.result_objects(scene)), 8)
 
     def test_cancel_before_first_pass_changes_nothing(self):
         scene, op, job, result, _ = self.run_worker(cancel_at_pass=0)
@@ -417,7 +414,7 @@ class CommandLineTest(unittest.TestCase):
             self.assertTrue(os.path.exists(out))
             bpy.ops.wm.open_mainfile(filepath=out)
         scene = bpy.context.scene
-        self.assertEqual(len(bake.result_objects(scene)), 8)
+        self.assertEqual(len(result_state.result_objects(scene)), 8)
         self.assertTrue(scene.radiosity.stats.valid)
 
 

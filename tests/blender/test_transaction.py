@@ -1,6 +1,6 @@
 """A solve that fails or is cancelled at any step (the export, the native solve,
 writing its result) leaves the scene exactly as it was, the previous result
-included (addon/result_state.py).
+included (addon/scene_transaction.py).
 
 Each step the operator takes after the native solve (replacing the result
 objects, hiding the originals, showing the results, writing the attribute on
@@ -20,16 +20,20 @@ import unittest
 import bpy
 import numpy as np
 
-from radiosity import bake, bake_materials, export, native, operators
+from radiosity import bake, bake_materials, export, native, operators, pipeline, result_state
 from test_addon import scene_snapshot
 from test_solve import open_scene
 
-# The steps each output mode takes after the native solve (operators.py, _finish).
+# The steps each output mode takes after the native solve (pipeline.py, finish),
+# as (module, function).
 STEPS = {
-    'REFINED': ("write_refined", "hide_originals", "show_results", "set_viewport_attribute_colour"),
-    'LIGHTING': ("write_refined", "hide_originals", "show_results", "set_viewport_attribute_colour"),
-    'BOTH': ("write_refined", "hide_originals", "show_results", "write_original", "set_viewport_attribute_colour"),
-    'ORIGINAL': ("restore_originals", "write_original", "set_viewport_attribute_colour"),
+    'REFINED': ((bake, "write_refined"), (result_state, "hide_originals"), (result_state, "show_results"),
+                (bake, "set_viewport_attribute_colour")),
+    'LIGHTING': ((bake, "write_refined"), (result_state, "hide_originals"), (result_state, "show_results"),
+                 (bake, "set_viewport_attribute_colour")),
+    'BOTH': ((bake, "write_refined"), (result_state, "hide_originals"), (result_state, "show_results"),
+             (bake, "write_original"), (bake, "set_viewport_attribute_colour")),
+    'ORIGINAL': ((result_state, "restore_originals"), (bake, "write_original"), (bake, "set_viewport_attribute_colour")),
 }
 
 
@@ -86,7 +90,7 @@ def full_state(scene):
     state["attribute values"] = values
     state["result meshes"] = {o.name: (o.data.name, len(o.data.vertices), len(o.data.polygons),
                                        [m.name for m in o.data.materials])
-                              for o in bake.result_objects(scene)}
+                              for o in result_state.result_objects(scene)}
     state["tags"] = {o.name: dict((k, str(o[k])) for k in o.keys() if k.startswith("radiosity"))
                      for o in scene.objects}
     state["shading"] = [s.shading.color_type for scr in bpy.data.screens for a in scr.areas
@@ -117,7 +121,7 @@ def viewport_hidden_objects(scene):
 
 class FailingStepsChangeNothing(unittest.TestCase):
     def check(self, previous_output, output):
-        for step in STEPS[output]:
+        for module, step in STEPS[output]:
             with self.subTest(previous=previous_output, output=output, step=step):
                 scene = open_scene("cube")
                 if previous_output:
@@ -126,14 +130,14 @@ class FailingStepsChangeNothing(unittest.TestCase):
                 before = full_state(scene)
                 scene.radiosity.output = output
                 scene.radiosity.oracle = 'STANDARD'
-                original = getattr(bake, step)
-                setattr(bake, step, failing_after(original))
+                original = getattr(module, step)
+                setattr(module, step, failing_after(original))
                 try:
                     # The operator reports the error, which bpy.ops raises.
                     with self.assertRaisesRegex(RuntimeError, "injected after " + step):
                         bpy.ops.radiosity.solve()
                 finally:
-                    setattr(bake, step, original)
+                    setattr(module, step, original)
                 self.assertEqual(full_state(scene), before)
 
     def test_first_solve(self):
@@ -169,7 +173,7 @@ class FailingStepsChangeNothing(unittest.TestCase):
             ('BOTH', 'REFINED', bake_materials, "add_light_attribute"),  # their attributes
             ('REFINED', 'BOTH', bake, "set_colour_attribute"),       # attributes of meshes
             ('BOTH', 'ORIGINAL', bake, "set_colour_attribute"),      # attributes of the originals
-            ('ORIGINAL', 'REFINED', bake.json, "dumps"),             # hiding the originals
+            ('ORIGINAL', 'REFINED', result_state.json, "dumps"),     # hiding the originals
         ]
         for previous, output, module, name in cases:
             with self.subTest(previous=previous, output=output, step=name):
@@ -243,11 +247,10 @@ class FailingStepsChangeNothing(unittest.TestCase):
                 before = full_state(scene)
                 solver = native.load()
                 op = Reports()
-                op._finish = lambda context, job: operators.RADIOSITY_OT_solve._finish(op, context, job)
-                job = operators.RADIOSITY_OT_solve._prepare(op, bpy.context, solver)
+                job = pipeline.prepare(bpy.context, solver)
                 token = solver.CancelToken()
                 token.cancel()
-                worker = threading.Thread(target=operators.RADIOSITY_OT_solve._work, args=(solver, job, token))
+                worker = threading.Thread(target=pipeline.work, args=(solver, job, token))
                 worker.start()
                 worker.join(120)
                 self.assertFalse(worker.is_alive())

@@ -24,7 +24,7 @@ import unittest
 import bpy
 import numpy as np
 
-from radiosity import bake, export
+from radiosity import bake, export, result_state
 from test_solve import open_scene
 from scene_kit import emission_material  # noqa: E402  (scenes/ is on the path: test_solve)
 
@@ -49,7 +49,7 @@ def quad(scene, name, z, size=1.0, facing_down=False, collection=None):
 
 def all_finite_results(scene):
     """Every number the result put in the scene is finite: positions, attributes, UV maps."""
-    for obj in bake.result_objects(scene):
+    for obj in result_state.result_objects(scene):
         mesh = obj.data
         co = np.empty(3 * len(mesh.vertices))
         mesh.vertices.foreach_get("co", co)
@@ -64,7 +64,7 @@ def all_finite_results(scene):
             yield obj.name, layer.name, uv
     for obj in scene.objects:
         attr = obj.data.color_attributes.get(bake.ATTRIBUTE) if obj.type == 'MESH' and \
-            not obj.get(export.RESULT_TAG) else None
+            not obj.get(result_state.RESULT_TAG) else None
         if attr is not None:
             v = np.empty(4 * len(attr.data), dtype=np.float32)
             attr.data.foreach_get("color", v)
@@ -115,7 +115,7 @@ class UserNamesTest(unittest.TestCase):
             mat = bpy.data.materials.new(name)
             mat.use_fake_user = True
             self.materials.append(mat)
-        self.collection = bpy.data.collections.new(bake.COLLECTION_NAME)
+        self.collection = bpy.data.collections.new(result_state.COLLECTION_NAME)
         scene.collection.children.link(self.collection)
         empty = bpy.data.objects.new("In user collection", None)
         self.collection.objects.link(empty)
@@ -131,8 +131,8 @@ class UserNamesTest(unittest.TestCase):
                 key = "mesh " + solved.data.name
                 state[key] = state[key][:3] + (sorted(set(state[key][3]) - {bake.ATTRIBUTE}),)
             self.assertEqual(state, before, step)
-            results = bake.result_objects(scene)
-            self.assertTrue(all(o.get(export.RESULT_TAG) for o in results), step)
+            results = result_state.result_objects(scene)
+            self.assertTrue(all(o.get(result_state.RESULT_TAG) for o in results), step)
             self.assertFalse({o.name for o in results} & user_names, step)
             self.assertFalse(any(o.get("mine") for o in results), step)
 
@@ -151,7 +151,7 @@ class UserNamesTest(unittest.TestCase):
             scene.radiosity.output = output
             solve()
             check_hidden_while_shown("solve " + output)
-            names = sorted(o.name for o in bake.result_objects(scene))
+            names = sorted(o.name for o in result_state.result_objects(scene))
             self.assertIn("Cube Radiosity.001", names)    # the user's holds "Cube Radiosity"
             self.assertIn("Ceiling Radiosity Radiosity", names)
         self.assertEqual(bpy.ops.radiosity.toggle_result(), {'FINISHED'})
@@ -162,8 +162,8 @@ class UserNamesTest(unittest.TestCase):
         solve()
         self.assertEqual(bpy.ops.radiosity.clear(), {'FINISHED'})
         check("remove")
-        self.assertFalse(bake.result_objects(scene))
-        self.assertFalse([o for o in bpy.data.objects if o.get(export.RESULT_TAG)])
+        self.assertFalse(result_state.result_objects(scene))
+        self.assertFalse([o for o in bpy.data.objects if o.get(result_state.RESULT_TAG)])
 
 
 class UserAttributeTest(unittest.TestCase):
@@ -190,7 +190,8 @@ class UserAttributeTest(unittest.TestCase):
             self.assertIn('no attribute on Cube (it has its own "%s" attribute)' % bake.ATTRIBUTE, warning)
             unchanged()
             # The other originals get theirs.
-            others = [o for o in scene.objects if o.type == 'MESH' and o is not cube and not o.get(export.RESULT_TAG)]
+            others = [o for o in scene.objects
+                      if o.type == 'MESH' and o is not cube and not o.get(result_state.RESULT_TAG)]
             self.assertTrue(any(o.data.color_attributes.get(bake.ATTRIBUTE) for o in others))
         self.assertEqual(bpy.ops.radiosity.clear(), {'FINISHED'})
         unchanged()
@@ -214,14 +215,14 @@ class NonFiniteCoordinatesTest(unittest.TestCase):
             warning = solve()
             self.assertIn("non-finite (NaN or Inf) coordinates, left out: Cube (%d of %d faces), Lost (all 1 face)"
                           % (faces_of_vertex, len(cube.data.polygons)), warning)
-            names = {o.name for o in bake.result_objects(scene)}
+            names = {o.name for o in result_state.result_objects(scene)}
             self.assertIn("Cube Radiosity", names)
             self.assertNotIn("Lost Radiosity", names)
             for name, what, values in all_finite_results(scene):
                 self.assertTrue(np.isfinite(values).all(), (output, name, what))
             # The cube's other faces are solved and lit; the attribute on the original
             # covers the faces solved (the rest stay black).
-            cube_result = [o for o in bake.result_objects(scene) if o.name == "Cube Radiosity"][0]
+            cube_result = [o for o in result_state.result_objects(scene) if o.name == "Cube Radiosity"][0]
             self.assertEqual(len(cube_result.data.uv_layers), len(cube.data.uv_layers))
             if output == 'BOTH':
                 attr = cube.data.color_attributes[bake.ATTRIBUTE]
@@ -260,7 +261,7 @@ class BrokenFacesTest(unittest.TestCase):
         expected = 100 * np.max(np.abs((q - q.mean(axis=0)) @ normal)) / np.linalg.norm(q[2] - q[0])
         self.assertAlmostEqual(float(found.group(1)), expected, delta=0.01)
         self.assertIn("faces left out: Bow: 1 face its outline crosses itself", warning)
-        names = {o.name for o in bake.result_objects(scene)}
+        names = {o.name for o in result_state.result_objects(scene)}
         self.assertIn("Bent Radiosity", names)
         self.assertNotIn("Bow Radiosity", names)
         for name, what, values in all_finite_results(scene):

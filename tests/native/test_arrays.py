@@ -1,6 +1,6 @@
-"""The add-on's array logic (addon/geometry.py) in plain Python: no Blender needed.
+"""The add-on's array logic (addon/arrays.py) in plain Python: no Blender needed.
 
-run_tests.py puts build/addon/radiosity on sys.path, where geometry.py is
+run_tests.py puts build/addon/radiosity on sys.path, where arrays.py is
 copied by the build; it imports only numpy.
 """
 
@@ -9,7 +9,7 @@ import unittest
 
 import numpy as np
 
-import geometry
+import arrays
 
 
 def polygon_area_normal(points):
@@ -22,17 +22,17 @@ def polygon_area_normal(points):
 
 class AreaLightTest(unittest.TestCase):
     def test_factor_by_version(self):
-        self.assertEqual(geometry.area_light_factor((3, 4, 1)), 0.25)
-        self.assertAlmostEqual(geometry.area_light_factor((4, 1, 0)), 1 / math.pi)
+        self.assertEqual(arrays.area_light_factor((3, 4, 1)), 0.25)
+        self.assertAlmostEqual(arrays.area_light_factor((4, 1, 0)), 1 / math.pi)
 
     def test_radiance_with_exposure_and_normalize(self):
         colour = (1.0, 0.5, 0.25)
-        np.testing.assert_allclose(geometry.area_light_radiance((3, 4, 1), 10.0, 0.5, colour),
+        np.testing.assert_allclose(arrays.area_light_radiance((3, 4, 1), 10.0, 0.5, colour),
                                    [5.0, 2.5, 1.25])
-        np.testing.assert_allclose(geometry.area_light_radiance((4, 5, 0), 10.0, 0.5, colour, exposure=2.0),
+        np.testing.assert_allclose(arrays.area_light_radiance((4, 5, 0), 10.0, 0.5, colour, exposure=2.0),
                                    np.multiply(colour, 4 * 10.0 / (math.pi * 0.5)))
         # Not normalized: the power is not spread over the area.
-        np.testing.assert_allclose(geometry.area_light_radiance((4, 5, 0), 10.0, 0.5, colour, normalize=False),
+        np.testing.assert_allclose(arrays.area_light_radiance((4, 5, 0), 10.0, 0.5, colour, normalize=False),
                                    np.multiply(colour, 10.0 / math.pi))
 
     def test_shapes_face_down_with_the_ideal_area(self):
@@ -40,7 +40,7 @@ class AreaLightTest(unittest.TestCase):
                                     ('DISK', 0.5, 9.0, math.pi * 0.0625),
                                     ('ELLIPSE', 0.5, 0.2, math.pi * 0.25 * 0.1)):
             with self.subTest(shape=shape):
-                points, ideal = geometry.area_light_polygon(shape, sx, sy)
+                points, ideal = arrays.area_light_polygon(shape, sx, sy)
                 self.assertAlmostEqual(ideal, area, places=12)
                 got, normal = polygon_area_normal(points)
                 # Round shapes: the polygon is grown to emit the same power.
@@ -50,40 +50,40 @@ class AreaLightTest(unittest.TestCase):
     def test_scaled_area(self):
         m = np.diag([2.0, 3.0, 5.0, 1.0])
         m[:3, 3] = (1, 2, 3)
-        self.assertAlmostEqual(geometry.scaled_area(m, 0.5), 3.0)
+        self.assertAlmostEqual(arrays.scaled_area(m, 0.5), 3.0)
 
     def test_unknown_shape(self):
         with self.assertRaises(ValueError):
-            geometry.area_light_polygon('TRIANGLE', 1, 1)
+            arrays.area_light_polygon('TRIANGLE', 1, 1)
 
 
 class PolygonArraysTest(unittest.TestCase):
     def test_polygon_corners_follow_loop_start(self):
         # Two polygons whose loops are stored out of order.
         loop_vertex = np.array([7, 8, 9, 1, 2, 3, 4])
-        corners = geometry.polygon_corners([3, 0], [4, 3], loop_vertex)
+        corners = arrays.polygon_corners([3, 0], [4, 3], loop_vertex)
         np.testing.assert_array_equal(corners, [1, 2, 3, 4, 7, 8, 9])
 
     def test_reverse_polygons(self):
-        np.testing.assert_array_equal(geometry.reverse_polygons([0, 1, 2, 3, 4, 5, 6], [4, 3]),
+        np.testing.assert_array_equal(arrays.reverse_polygons([0, 1, 2, 3, 4, 5, 6], [4, 3]),
                                       [3, 2, 1, 0, 6, 5, 4])
 
     def test_srgb(self):
-        np.testing.assert_allclose(geometry.srgb_to_linear([0.0, 0.04045, 0.5, 1.0]),
+        np.testing.assert_allclose(arrays.srgb_to_linear([0.0, 0.04045, 0.5, 1.0]),
                                    [0.0, 0.04045 / 12.92, 0.21404114, 1.0], rtol=1e-6)
 
     def test_normals_and_offset(self):
         p = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 0], [0, 1, 0], [1, 0, 0.0]])
         fv = np.array([0, 1, 2, 3, 4, 5, 6])
-        np.testing.assert_allclose(geometry.polygon_normals(p, fv, [4, 3]), [[0, 0, 1], [0, 0, -1]], atol=1e-12)
-        moved = geometry.offset_sides(p, fv, [4, 3], 0.01)
+        np.testing.assert_allclose(arrays.polygon_normals(p, fv, [4, 3]), [[0, 0, 1], [0, 0, -1]], atol=1e-12)
+        moved = arrays.offset_sides(p, fv, [4, 3], 0.01)
         np.testing.assert_allclose(moved[:4, 2], 0.01)
         np.testing.assert_allclose(moved[4:, 2], -0.01)
 
 
 class SceneBuilderTest(unittest.TestCase):
     def test_parts_concatenate(self):
-        b = geometry.SceneBuilder()
+        b = arrays.SceneBuilder()
         quad = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.0]])
         self.assertEqual(b.add(quad, [0, 1, 2, 3], [4], [0.5, 0.5, 0.5], [0, 0, 0], True), 0)
         self.assertEqual(b.add(quad + [0, 0, 1], [0, 1, 2, 0, 2, 3], [3, 3], [[2, 0, 0], [0.1, 0.2, 0.3]],
@@ -97,7 +97,7 @@ class SceneBuilderTest(unittest.TestCase):
         self.assertEqual(a["reflectance"].max(), 1.0)   # clipped into [0, 1]
 
     def test_empty(self):
-        a = geometry.SceneBuilder().arrays()
+        a = arrays.SceneBuilder().arrays()
         self.assertEqual(a["positions"].shape, (0, 3))
         self.assertEqual(len(a["face_sizes"]), 0)
 
@@ -113,7 +113,7 @@ class ResultArraysTest(unittest.TestCase):
     radiance = np.arange(24, dtype=float).reshape(8, 3)
 
     def test_split_by_part(self):
-        pieces = geometry.split_result(self.face_vertices, self.face_sizes, np.array([1, 1, 0]), 3)
+        pieces = arrays.split_result(self.face_vertices, self.face_sizes, np.array([1, 1, 0]), 3)
         self.assertIsNone(pieces[2])
         polygons, vertices, local = pieces[1]
         np.testing.assert_array_equal(polygons, [0, 1])
@@ -125,7 +125,7 @@ class ResultArraysTest(unittest.TestCase):
         # Input faces: face 0 a quad whose corners are result vertices 0..3 (given in
         # another order), face 1 the upper quad.
         points = self.positions[[1, 2, 3, 0, 4, 5, 6, 7]] + 1e-12
-        values, unmatched = geometry.corner_values(
+        values, unmatched = arrays.corner_values(
             points, [4, 4], [0, 1], self.positions, self.face_vertices, self.face_sizes,
             self.source_face, self.source_side, self.radiance, tolerance=1e-7)
         self.assertEqual(unmatched, 0)
@@ -133,7 +133,7 @@ class ResultArraysTest(unittest.TestCase):
 
     def test_unmatched_corner_takes_the_face_mean(self):
         points = np.array([[0.5, 0.5, 1.0], [1, 0, 1], [1, 1, 1], [0, 1, 1]])
-        values, unmatched = geometry.corner_values(
+        values, unmatched = arrays.corner_values(
             points, [4], [1], self.positions, self.face_vertices, self.face_sizes,
             self.source_face, self.source_side, self.radiance, tolerance=1e-7)
         self.assertEqual(unmatched, 1)

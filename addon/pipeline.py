@@ -1,0 +1,222 @@
+"""A solve without its UI: settings -> native options, export -> solve -> bake.
+
+The operator (operators.py) calls these in order. `prepare` exports the scene
+and makes the native Scene and the solver's options (main thread); the native
+solve runs in `solve` (on the calling thread) or in `work` (on a worker thread:
+it touches no bpy, and the native solve releases the GIL); `conclude` (main
+thread) turns the job's error into a SolveError or `finish`es: bakes the result
+in one transaction (scene_transaction.py) and writes the statistics into
+scene.radiosity.stats. Failures the user can act on raise SolveError, whose
+message is reported as is; a failure leaves the scene as it was.
+"""
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import bake, export, game_export, result_state, scene_transaction
+
+STATUS = {
+    "quality": "Converged",
+    "max_elements": "Element budget reached",
+    "memory": "Memory limit reached (refinement stopped there)",
+    "time_budget": "Time budget reached",
+    "cancel": "Cancelled (last complete pass kept)",
+}
+
+
+class SolveError(Exception):
+    """A failure the user can act on; its message is reported as is."""
+
+
+# What the native module raises for input it refuses (ValueError) or a scene
+# too large for memory (MemoryError): the user can act on both.
+REFUSALS = (ValueError, MemoryError)
+
+
+@dataclass
+class Job:
+    """What a solve carries from the main thread to the worker and back."""
+    scene_name: str
+    exported: export.ExportedScene
+    native_scene: object
+    options: dict
+    oracle_label: str
+    progress: dict = field(default_factory=dict)
+    result: object = None
+    error: BaseException = None
+    started: float = field(default_factory=time.perf_counter)  # when the Solve began
+
+
+def native_options(options, total_area):
+    """scene.radiosity.solver_options() in the form rad.solve takes (0 = no limit or
+    automatic); the smallest element's edge becomes a fraction of the scene's area."""
+    extra = {}
+    size = float(options.get("min_element_size", 0.0))
+    if size > 0.0 and total_area > 0.0:
+        extra["min_element_area"] = min(size * size / total_area, 0.5)
+    return extra | {
+        "oracle": options["oracle"],
+        "quality": float(options["quality"]),
+        "max_elements": int(options["max_elements"]) or None,
+        "time_budget": float(options["time_budget"]) or None,
+        "visibility": options["visibility"],
+        "rays": int(options["rays"]),
+        "bounces": int(options["bounces"]) or None,
+    }
+
+
+# Writing a result into the scene (meshes, attributes, UV maps) takes about
+# this long per element on the 2-core reference machine (7.5 s for the 400,000
+# elements of a 200,000-face plane, bench/addon_budget.py).
+WRITE_SECONDS_PER_ELEMENT = 2e-5
+# What the solver gets when the export has used up the budget: its first pass.
+MIN_SOLVE_BUDGET = 0.05
+
+
+def solve_budget(budget, started, elements):
+    """The share of the user's time budget (seconds; 0: no limit) left to the
+    solver: the budget is for the whole Solve, so what the export took since
+    `started` is spent and writing the `elements` the solve starts with is
+    kept back."""
+    if not budget:
+        return None
+    left = budget - (time.perf_counter() - started) - WRITE_SECONDS_PER_ELEMENT * elements
+    return max(MIN_SOLVE_BUDGET, left)
+
+
+def visibility_hint(visibility, stats):
+    """A hint when exact visibility made the linking of a large scene slow:
+    sampled visibility links a 10,000-face room in about half a minute, where
+    exact visibility takes many minutes (native/README.md)."""
+    if visibility != 'exact' or stats.get("seconds_linking", 0.0) < 10.0:
+        return ""
+    return ("linking took %.0f s with exact visibility: for scenes this large, Visibility 'Sampled' "
+            "is many times faster" % stats["seconds_linking"])
+
+
+def prepare(context, solver, started=None):
+    """Export the scene and make the native Scene (main thread); the Solve
+    began at `started` (time.perf_counter; None: now)."""
+    started = time.perf_counter() if started is None else started
+    scene = context.scene
+    # What a render shows, the originals the last solve hid included, is read,
+    # whatever the viewport hides; every flag is put back after.
+    with result_state.OriginalsShown(scene, context.view_layer), export.rendered_shown(context.view_layer):
+        exported = export.export_scene(context)
+    arrays = exported.arrays
+    note = "; ".join(exported.repaired + ([export.unmodelled_message(exported.unmodelled)]
+                                          if exported.unmodelled else []))
+    if exported.face_count == 0:
+        raise SolveError("Nothing to solve: the scene has no visible mesh objects or area lights"
+                         + (" (%s)" % note if note else ""))
+    if not np.any(arrays["emission"] > 0) and not exported.lights and exported.world is None:
+        raise SolveError("No light to solve: add a light, an emissive material (Emission shader or "
+                         "Principled Emission) or a world colour"
+                         + (" (%s)" % note if note else ""))
+    try:
+        native_scene = solver.Scene(arrays["positions"], arrays["face_vertices"], arrays["face_sizes"],
+                                    arrays["reflectance"], arrays["emission"], arrays["two_sided"],
+                                    occludes=arrays["occludes"], lights=exported.lights,
+                                    world=exported.world)
+    except ValueError as err:
+        raise SolveError("Radiosity: %s" % err) from None
+    settings = scene.radiosity
+    label = settings.bl_rna.properties["oracle"].enum_items[settings.oracle].name
+    options = native_options(settings.solver_options(), native_scene.total_area)
+    options["time_budget"] = solve_budget(settings.time_budget, started, 2 * native_scene.patch_count)
+    return Job(scene_name=scene.name, exported=exported, native_scene=native_scene, options=options,
+               oracle_label=label, started=started)
+
+
+def solve(solver, job, progress=None):
+    """The native solve on the calling thread; `progress` is called with the solver's reports."""
+    try:
+        job.result = solver.solve(job.native_scene, progress=progress, **job.options)
+    except REFUSALS as err:
+        raise SolveError("Radiosity: %s" % err) from None
+
+
+def work(solver, job, token):
+    """The worker thread: only the native solve, which releases the GIL."""
+    try:
+        job.result = solver.solve(job.native_scene, progress=job.progress.update,
+                                  cancel=token, **job.options)
+    except BaseException as err:  # reported on the main thread
+        job.error = err
+
+
+def conclude(context, job):
+    """Raise a finished job's error, or bake its result (main thread)."""
+    if job.error is not None:
+        if isinstance(job.error, REFUSALS):
+            raise SolveError("Radiosity: %s" % job.error)
+        raise job.error
+    return finish(context, job)
+
+
+def finish(context, job):
+    """Bake the result into the scene and record the statistics in
+    scene.radiosity.stats, which it returns (main thread)."""
+    result = job.result
+    stats = result.stats
+    if len(result.face_sizes) == 0:
+        if stats.get("cancelled"):
+            raise SolveError("Radiosity solve cancelled before the first pass: scene unchanged")
+        raise SolveError("Radiosity: the solver returned no surfaces (every face degenerate?)")
+    scene = context.scene
+    settings = scene.radiosity
+    mode = settings.output
+    skipped_objects = []
+    warnings = []
+    convert = material = None
+    # Lighting Only keeps the user's materials, which no unlit material can
+    # stand in for: game-ready colours apply to the other outputs.
+    if settings.display_colours and mode != 'LIGHTING':
+        convert, material, note = game_export.bake_options(scene)
+        if note:
+            warnings.append(note)
+    # One transaction: a failure at any step leaves the scene as it was (scene_transaction.py).
+    with scene_transaction.SceneTransaction(scene, context.view_layer) as transaction:
+        if mode in {'REFINED', 'BOTH', 'LIGHTING'}:
+            bake.write_refined(scene, job.exported, result, settings.show_wireframe,
+                               convert=convert, material=material, lighting=mode == 'LIGHTING',
+                               replace_previous=lambda _: transaction.retire_results())
+            result_state.hide_originals(scene, context.view_layer, job.exported.hidden_sources)
+            result_state.show_results(scene, True)
+        else:
+            transaction.retire_results()
+            result_state.restore_originals(scene, context.view_layer)
+        if mode in {'ORIGINAL', 'BOTH'}:
+            skipped_objects = bake.write_original(scene, job.exported, result, convert=convert)
+        bake.set_viewport_attribute_colour()
+
+    warnings.extend(job.exported.repaired)
+    note = export.unmodelled_message(job.exported.unmodelled)
+    if note:
+        warnings.append(note)
+    hint = visibility_hint(job.options.get("visibility"), stats)
+    if hint:
+        warnings.append(hint)
+    coincident = export.coincident_message(job.exported, job.native_scene.coincident_faces)
+    if coincident:
+        warnings.append(coincident)
+    for notes, what in ((job.native_scene.skipped_faces, "faces left out:"),
+                        (job.native_scene.repaired_faces, "faces repaired:")):
+        message = export.face_notes_message(job.exported, notes, what)
+        if message:
+            warnings.append(message)
+    for reason in sorted({why for _, why in skipped_objects}):
+        warnings.append("no attribute on %s (%s)" % (
+            ", ".join(sorted({name for name, why in skipped_objects if why == reason})), reason))
+    s = settings.stats
+    s.valid = True
+    s.status = STATUS.get(stats.get("stopped_by", ""), str(stats.get("stopped_by", "")))
+    s.oracle = job.oracle_label
+    s.elements = int(stats.get("leaves", 0))
+    s.links = int(stats.get("links", 0))
+    s.iterations = int(stats.get("iterations", 0))
+    s.seconds = float(stats.get("seconds", 0.0))
+    s.warning = "; ".join(warnings)
+    return s
