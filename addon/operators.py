@@ -31,8 +31,8 @@ _running_job = None
 
 def running_progress():
     """The progress dict of the interactive solve running now (the solver's
-    last report: pass, passes, phase, elements, links, seconds, fraction), or
-    None when none runs."""
+    last report: pass, passes, phase, elements, leaves, links, seconds,
+    fraction), or None when none runs."""
     job = _running_job
     return None if job is None else dict(job.progress)
 
@@ -41,9 +41,10 @@ def progress_text(progress):
     """One line describing a progress dict of the solver."""
     if not progress:
         return "Radiosity: starting"
-    return "Radiosity: pass {} of {}, {}, {:,} elements, {:,} links, {:.1f} s".format(
-        progress.get("pass", 0), progress.get("passes", 0), progress.get("phase", ""),
-        progress.get("elements", 0), progress.get("links", 0), progress.get("seconds", 0.0))
+    return "Radiosity: {:.0%}, pass {} of {}, {}, {:,} elements, {:,} links, {:.1f} s".format(
+        progress.get("fraction", 0.0), progress.get("pass", 0) + 1, progress.get("passes", 0),
+        progress.get("phase", ""), progress.get("leaves", progress.get("elements", 0)),
+        progress.get("links", 0), progress.get("seconds", 0.0))
 
 
 def pass_printer():
@@ -93,6 +94,8 @@ class RADIOSITY_OT_solve(Operator):
             return self._unexpected(err)
         global _running_job
         self._job = _running_job = job
+        job.monitor = solver.ProgressMonitor(pass_results=True)
+        self._live = None  # the passes shown so far (pipeline.LiveResult)
         self._token = solver.CancelToken()
         self._thread = threading.Thread(target=pipeline.work, args=(solver, job, self._token),
                                         name="radiosity-solve", daemon=True)
@@ -111,24 +114,51 @@ class RADIOSITY_OT_solve(Operator):
             return {'RUNNING_MODAL'}
         # Any timer tick will do (other timers tick too; checking is cheap).
         if event.type == 'TIMER':
-            if self._thread.is_alive():
-                progress = dict(self._job.progress)
-                context.window_manager.progress_update(100.0 * float(progress.get("fraction", 0.0)))
-                if not self._token.cancelled:
-                    context.workspace.status_text_set(progress_text(progress) + "  (Esc to cancel)")
+            alive = self._thread.is_alive()
+            self._poll(context)
+            if alive:
                 return {'RUNNING_MODAL'}
             self._stop_modal(context)
-            return self._conclude(context, self._job)
+            return self._conclude(context, self._job, self._live)
         if event.type in {'MIDDLEMOUSE', 'WHEELUPMOUSE', 'WHEELDOWNMOUSE', 'TRACKPADPAN',
                           'TRACKPADZOOM', 'MOUSEMOVE', 'INBETWEEN_MOUSEMOVE'}:
             return {'PASS_THROUGH'}  # let the user look around while it solves
         return {'RUNNING_MODAL'}
 
     def cancel(self, context):
-        # Blender ends the operator (file closed, window gone): stop the worker.
+        # Blender ends the operator (file closed, window gone): stop the worker
+        # and put back what the passes showed.
         self._token.cancel()
         self._thread.join()
         self._stop_modal(context)
+        if self._live is not None:
+            self._live.abort()
+
+    def _poll(self, context):
+        """Show the solver's progress and the newest pass's solution (timer, main thread)."""
+        job = self._job
+        progress = job.monitor.progress()
+        if progress is not None:
+            job.progress = progress
+            context.window_manager.progress_update(100.0 * float(progress.get("fraction", 0.0)))
+            if not self._token.cancelled:
+                context.workspace.status_text_set(progress_text(progress) + "  (Esc to cancel)")
+        result = job.monitor.take_pass_result()
+        if result is None:
+            return
+        try:
+            if self._live is None:
+                self._live = pipeline.LiveResult(context)
+            self._live.show(context, job, result)
+        except Exception:
+            # The scene is back as it was (LiveResult.abort); the solve goes on
+            # and its final bake reports what fails.
+            traceback.print_exc(file=sys.stderr)
+            self._live = None
+        # Redraw the panels too: the statistics and the progress bar live there.
+        for area in context.screen.areas if context.screen else ():
+            if area.type in {'VIEW_3D', 'PROPERTIES'}:
+                area.tag_redraw()
 
     def _stop_modal(self, context):
         global _running_job
@@ -155,11 +185,11 @@ class RADIOSITY_OT_solve(Operator):
             return self._unexpected(err)
         return self._conclude(context, job)
 
-    def _conclude(self, context, job):
+    def _conclude(self, context, job, live=None):
         """Bake a finished job's result and report how the solve ended, or
-        report its error (main thread)."""
+        report its error (main thread). `live`: the passes shown so far."""
         try:
-            stats = pipeline.conclude(context, job)
+            stats = pipeline.conclude(context, job, live)
         except pipeline.SolveError as err:
             self.report({'ERROR'}, str(err))
             return {'CANCELLED'}

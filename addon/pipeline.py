@@ -43,7 +43,8 @@ class Job:
     native_scene: object
     options: dict
     oracle_label: str
-    progress: dict = field(default_factory=dict)
+    progress: dict = field(default_factory=dict)  # the solver's last report
+    monitor: object = None  # the native ProgressMonitor of an interactive solve
     result: object = None
     error: BaseException = None
     started: float = field(default_factory=time.perf_counter)  # when the Solve began
@@ -139,32 +140,58 @@ def solve(solver, job, progress=None):
 
 
 def work(solver, job, token):
-    """The worker thread: only the native solve, which releases the GIL."""
+    """The worker thread: only the native solve, which releases the GIL and
+    reports into job.monitor (polled by the UI) without ever waiting for it."""
     try:
-        job.result = solver.solve(job.native_scene, progress=job.progress.update,
-                                  cancel=token, **job.options)
+        # The window's thread keeps its priority: Esc, redraws and the timer that
+        # shows the passes stay prompt while the solve takes every idle cycle.
+        job.result = solver.solve(job.native_scene, progress=job.monitor, cancel=token,
+                                  yield_to_interface=job.monitor is not None, **job.options)
     except BaseException as err:  # reported on the main thread
         job.error = err
 
 
-def conclude(context, job):
-    """Raise a finished job's error, or bake its result (main thread)."""
+def conclude(context, job, live=None):
+    """Raise a finished job's error (putting back what `live` showed), or
+    bake its result (main thread)."""
     if job.error is not None:
+        if live is not None:
+            live.abort(job.error)
         if isinstance(job.error, REFUSALS):
             raise SolveError("Radiosity: %s" % job.error)
         raise job.error
-    return finish(context, job)
+    try:
+        return finish(context, job, live)
+    except BaseException as err:
+        if live is not None:
+            live.abort(err)
+        raise
 
 
-def finish(context, job):
+def finish(context, job, live=None):
     """Bake the result into the scene and record the statistics in
-    scene.radiosity.stats, which it returns (main thread)."""
+    scene.radiosity.stats, which it returns (main thread). `live`: the
+    LiveResult that showed the passes of an interactive solve, whose
+    transaction this completes."""
     result = job.result
     stats = result.stats
     if len(result.face_sizes) == 0:
         if stats.get("cancelled"):
             raise SolveError("Radiosity solve cancelled before the first pass: scene unchanged")
         raise SolveError("Radiosity: the solver returned no surfaces (every face degenerate?)")
+    if live is not None:
+        skipped_objects, warnings = live.finish(context, job, result)
+    else:
+        # One transaction: a failure at any step leaves the scene as it was (scene_transaction.py).
+        with scene_transaction.SceneTransaction(context.scene, context.view_layer) as transaction:
+            skipped_objects, warnings = bake_result(context, job, result, transaction.retire_results)
+    return record(context, job, stats, skipped_objects, warnings)
+
+
+def bake_result(context, job, result, replace_previous):
+    """Write `result` into the scene as the settings' output asks (inside a
+    SceneTransaction); `replace_previous(scene)` takes the result shown before
+    away. Returns the objects that got no attribute and the warnings."""
     scene = context.scene
     settings = scene.radiosity
     mode = settings.output
@@ -177,21 +204,74 @@ def finish(context, job):
         convert, material, note = game_export.bake_options(scene)
         if note:
             warnings.append(note)
-    # One transaction: a failure at any step leaves the scene as it was (scene_transaction.py).
-    with scene_transaction.SceneTransaction(scene, context.view_layer) as transaction:
-        if mode in {'REFINED', 'BOTH', 'LIGHTING'}:
-            bake.write_refined(scene, job.exported, result, settings.show_wireframe,
-                               convert=convert, material=material, lighting=mode == 'LIGHTING',
-                               replace_previous=lambda _: transaction.retire_results())
-            result_state.hide_originals(scene, context.view_layer, job.exported.hidden_sources)
-            result_state.show_results(scene, True)
-        else:
-            transaction.retire_results()
-            result_state.restore_originals(scene, context.view_layer)
-        if mode in {'ORIGINAL', 'BOTH'}:
-            skipped_objects = bake.write_original(scene, job.exported, result, convert=convert)
-        bake.set_viewport_attribute_colour()
+    if mode in {'REFINED', 'BOTH', 'LIGHTING'}:
+        bake.write_refined(scene, job.exported, result, settings.show_wireframe,
+                           convert=convert, material=material, lighting=mode == 'LIGHTING',
+                           replace_previous=replace_previous)
+        result_state.hide_originals(scene, context.view_layer, job.exported.hidden_sources)
+        result_state.show_results(scene, True)
+    else:
+        replace_previous(scene)
+        result_state.restore_originals(scene, context.view_layer)
+    if mode in {'ORIGINAL', 'BOTH'}:
+        skipped_objects = bake.write_original(scene, job.exported, result, convert=convert)
+    bake.set_viewport_attribute_colour()
+    return skipped_objects, warnings
 
+
+class LiveResult:
+    """An interactive solve's result shown as it refines: each pass's solution
+    replaces the one before, all inside one SceneTransaction that the final
+    result commits, so a failed solve still leaves the scene as it was and a
+    cancelled one keeps its last pass (main thread)."""
+
+    def __init__(self, context):
+        self.transaction = scene_transaction.SceneTransaction(context.scene, context.view_layer)
+        self.transaction.__enter__()
+        self.passes_shown = 0
+        self.outcome = ([], [])  # what the last bake returned (bake_result)
+        self.open = True
+
+    def _replace(self, scene):
+        # The user's previous result is retired (kept for a rollback); an
+        # earlier pass's meshes are this solve's own and simply go.
+        if self.passes_shown == 0:
+            self.transaction.retire_results()
+        else:
+            result_state.remove_results(scene)
+
+    def show(self, context, job, result):
+        """Bake one pass's solution (`result`, from the solver's ProgressMonitor)."""
+        try:
+            self.outcome = bake_result(context, job, result, self._replace)
+        except BaseException as err:
+            self.abort(err)
+            raise
+        self.passes_shown = int(result.stats.get("passes", self.passes_shown + 1))
+
+    def finish(self, context, job, result):
+        """Bake the final result unless the last pass shown was it, and commit."""
+        try:
+            if self.passes_shown != int(result.stats.get("passes", -1)) or self.passes_shown == 0:
+                self.outcome = bake_result(context, job, result, self._replace)
+        except BaseException as err:
+            self.abort(err)
+            raise
+        self.open = False
+        self.transaction.__exit__(None, None, None)
+        return self.outcome
+
+    def abort(self, error=None):
+        """Put the scene back as it was before the solve."""
+        if self.open:
+            self.open = False
+            error = error or RuntimeError("solve abandoned")
+            self.transaction.__exit__(type(error), error, None)
+
+
+def record(context, job, stats, skipped_objects, warnings):
+    """The warnings and statistics of a finished solve into scene.radiosity.stats."""
+    settings = context.scene.radiosity
     warnings.extend(job.exported.repaired)
     note = export.unmodelled_message(job.exported.unmodelled)
     if note:

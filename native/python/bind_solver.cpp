@@ -307,7 +307,7 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
                   const py::object& threads, const py::object& progress, const py::object& cancel,
                   double min_element_area, const std::string& leaf_links,
                   std::optional<double> cluster_separation, const py::object& memory_limit,
-                  bool pass_results) {
+                  bool pass_results, bool yield_to_interface) {
   SolveOptions options;
   options.oracle = read_oracle(oracle);
   options.quality = quality;
@@ -328,6 +328,7 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
     options.memory_limit = static_cast<std::size_t>(v);
   }
   options.min_element_area = min_element_area;
+  options.yield_to_interface = yield_to_interface;
   if (cluster_separation) {
     if (!(*cluster_separation > 1.0))
       throw std::invalid_argument(
@@ -540,7 +541,7 @@ void bind_solver(py::module_& m) {
         py::arg("cancel") = py::none(), py::arg("min_element_area") = defaults.min_element_area,
         py::arg("leaf_links") = std::string(leaf_links_name(defaults.leaf_links)),
         py::arg("cluster_separation") = py::none(), py::arg("memory_limit") = py::none(),
-        py::arg("pass_results") = false,
+        py::arg("pass_results") = false, py::arg("yield_to_interface") = false,
         "Hierarchical radiosity. oracle: 'standard' | 'perceptual' | 'gradient'; quality in\n"
         "[0, 1] (0: no refinement); max_elements, time_budget (s): budgets; visibility:\n"
         "'exact' | 'sampled' (rays per sample); bounces: fixed iteration count instead of\n"
@@ -555,7 +556,8 @@ void bind_solver(py::module_& m) {
         "and a scene that cannot fit unrefined raises MemoryError before any work.\n"
         "progress gets pass, passes (fixed), phase, elements, leaves, links, seconds and fraction\n"
         "(never decreasing); with pass_results, the 'pass' reports carry 'result': that pass's\n"
-        "solution, as solve() returns it.");
+        "solution, as solve() returns it. yield_to_interface: the solve's threads run at a lower\n"
+        "CPU priority than the process's others (a UI beside the solve).");
   m.def(
       "quality_threshold",
       [](const std::string& oracle, double quality) {

@@ -567,6 +567,28 @@ class Cancellation(unittest.TestCase):
         with self.assertRaises(ValueError):
             rad.solve(b.scene(rad), quality=0.0, progress=42)
 
+    def test_yielding_to_an_interface_lowers_only_the_solves_threads(self):
+        # Beside Blender's window the solve runs "nicer" than the window's thread;
+        # the result is the same.
+        import os
+        import threading
+        b, _ = room_with_blocker()
+        plain = rad.solve(b.scene(rad), oracle="standard", quality=0.3)
+        seen = {}
+
+        def work():
+            seen["result"] = rad.solve(b.scene(rad), oracle="standard", quality=0.3, yield_to_interface=True)
+            seen["nice"] = os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
+
+        before = os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
+        worker = threading.Thread(target=work)
+        worker.start()
+        worker.join()
+        self.assertEqual(os.getpriority(os.PRIO_PROCESS, threading.get_native_id()), before,
+                         "the caller's other threads keep their priority")
+        self.assertGreater(seen["nice"], before)
+        np.testing.assert_array_equal(seen["result"].radiance, plain.radiance)
+
     def test_linking_a_large_scene_reports_progress(self):
         # The cluster walk and the face links each report as they go, so a
         # progress bar moves during a long initial linking.

@@ -22,6 +22,7 @@
 #include "core/solve/link_batch.h"
 #include "core/solve/refine.h"
 #include "core/solve/timing.h"
+#include "core/solve/yield_priority.h"
 #include "radiosity/solve.h"
 
 namespace radiosity {
@@ -600,6 +601,12 @@ SolveResult solve(const Scene& scene, const SolveOptions& options, const Progres
     throw InsufficientMemory(m.str());
   }
   tbb::task_arena arena(options.threads ? *options.threads : tbb::task_arena::automatic);
+  std::optional<YieldPriority> yielding;
+  if (options.yield_to_interface) {
+    arena.initialize();  // an observer needs its arena
+    yielding.emplace(arena);
+    lower_this_thread_priority();  // the calling thread works in the arena too
+  }
   SolveResult result =
       arena.execute([&] { return Solver(scene, checked, progress, cancel).run(); });
   require_finite(result.mesh);

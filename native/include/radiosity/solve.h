@@ -62,6 +62,9 @@ struct SolveOptions {
   // refine/gather/push-pull iterations from L = L_e (the source's 3-iteration runs).
   std::optional<int> bounces;
   std::optional<int> threads;  // in [1, kMaxThreads]; default: all cores
+  // Run the solve's threads at a lower CPU priority than the caller's other
+  // threads (an interactive interface beside the solve; core/solve/yield_priority.h).
+  bool yield_to_interface = false;
   // Smallest element, as a fraction of the scene's total area (1e-5 of an
   // 80 m2 room is a 3 cm square).
   double min_element_area = 1e-5;
