@@ -257,17 +257,3 @@ def remove_original_attributes(scene):
             if attr is not None:
                 obj.data.color_attributes.remove(attr)
             del obj.data[ORIGINAL_ATTRIBUTE_TAG]
-
-
-# --- The 3D views ------------------------------------------------------------------------
-
-def set_viewport_attribute_colour():
-    """Solid shading shows colour attributes in every 3D view that exists."""
-    for screen in bpy.data.screens:
-        for area in screen.areas:
-            if area.type != 'VIEW_3D':
-                continue
-            for space in area.spaces:
-                if space.type == 'VIEW_3D':
-                    items = space.shading.bl_rna.properties["color_type"].enum_items
-                    space.shading.color_type = 'ATTRIBUTE' if 'ATTRIBUTE' in items else 'VERTEX'

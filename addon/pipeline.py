@@ -184,7 +184,8 @@ def finish(context, job, live=None):
     else:
         # One transaction: a failure at any step leaves the scene as it was (scene_transaction.py).
         with scene_transaction.SceneTransaction(context.scene, context.view_layer) as transaction:
-            skipped_objects, warnings = bake_result(context, job, result, transaction.retire_results)
+            skipped_objects, warnings = bake_result(context, job, result,
+                                                    lambda _: transaction.retire_results())
     return record(context, job, stats, skipped_objects, warnings)
 
 
@@ -215,7 +216,7 @@ def bake_result(context, job, result, replace_previous):
         result_state.restore_originals(scene, context.view_layer)
     if mode in {'ORIGINAL', 'BOTH'}:
         skipped_objects = bake.write_original(scene, job.exported, result, convert=convert)
-    bake.set_viewport_attribute_colour()
+    result_state.show_in_views(scene)
     return skipped_objects, warnings
 
 

@@ -228,6 +228,14 @@ class RadiositySettings(PropertyGroup):
         soft_max=10.0,
         default=0.0,
     )
+    view_result: BoolProperty(
+        name="View Result",
+        description=(
+            "Show the result in Solid shading as it will render: colour attribute, flat "
+            "lighting. Your shading settings come back when you toggle or remove the result"
+        ),
+        default=True,
+    )
     stats: PointerProperty(type=RadiosityStats)
 
     def solver_options(self):

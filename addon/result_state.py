@@ -24,6 +24,9 @@ HIDDEN_TAG = "radiosity_hidden"
 ORIGINAL_ATTRIBUTE_TAG = "radiosity_attribute"
 # The shared "Radiosity Emission" material (bake.emission_material).
 MATERIAL_TAG = "radiosity_material"
+# On the scene: how each 3D view was shaded before the result was shown in it
+# (show_in_views), to be put back when the originals come back.
+VIEWS_TAG = "radiosity_views"
 COLLECTION_NAME = "Radiosity"
 
 
@@ -128,6 +131,47 @@ def show_results(scene, show):
         obj.hide_viewport = not show
 
 
+# --- The 3D views ------------------------------------------------------------------------
+
+def _views():
+    """Every 3D view, with a key that finds it again (screen name, area and space index)."""
+    for screen in bpy.data.screens:
+        for a, area in enumerate(screen.areas):
+            for s, space in enumerate(area.spaces):
+                if space.type == 'VIEW_3D':
+                    yield "%s/%d/%d" % (screen.name, a, s), space
+
+
+def _attribute_colour(shading):
+    items = shading.bl_rna.properties["color_type"].enum_items
+    return 'ATTRIBUTE' if 'ATTRIBUTE' in items else 'VERTEX'  # 'VERTEX' before Blender 3.2
+
+
+def show_in_views(scene):
+    """With "View Result" on, solid shading in every 3D view shows the result's
+    colours as computed: the colour attribute, lit flat (studio lighting would
+    shade them again and show them darker than the render). How each view was
+    shaded before is saved once, for restore_views."""
+    if not scene.radiosity.view_result:
+        return
+    saved = json.loads(scene.get(VIEWS_TAG, "{}"))
+    for key, space in _views():
+        shading = space.shading
+        saved.setdefault(key, [shading.color_type, shading.light])
+        shading.color_type = _attribute_colour(shading)
+        shading.light = 'FLAT'
+    scene[VIEWS_TAG] = json.dumps(saved)
+
+
+def restore_views(scene):
+    """Shade the 3D views as they were before the result was shown in them."""
+    saved = json.loads(scene.get(VIEWS_TAG, "{}"))
+    for key, space in _views():
+        if key in saved:
+            space.shading.color_type, space.shading.light = saved[key]
+    scene.pop(VIEWS_TAG, None)
+
+
 # --- Toggling and removing ---------------------------------------------------------------
 
 def toggle(scene, view_layer):
@@ -135,10 +179,12 @@ def toggle(scene, view_layer):
     if any(o.get(HIDDEN_TAG) for o in scene.objects):
         restore_originals(scene, view_layer)
         show_results(scene, False)
+        restore_views(scene)
     else:
         sources = {o[RESULT_TAG] for o in result_objects(scene)}
         hide_originals(scene, view_layer, sorted(sources))
         show_results(scene, True)
+        show_in_views(scene)
 
 
 def clear(scene, view_layer):
@@ -149,3 +195,4 @@ def clear(scene, view_layer):
     if coll is not None and not coll.all_objects:
         bpy.data.collections.remove(coll)
     restore_originals(scene, view_layer)
+    restore_views(scene)

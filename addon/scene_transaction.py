@@ -54,7 +54,8 @@ class SceneTransaction:
                 attr = obj.data.color_attributes.get(bake.ATTRIBUTE)
                 self.attributes[obj.data] = (None if attr is None else _copy_attribute(attr),
                                              obj.data.get(ORIGINAL_ATTRIBUTE_TAG))
-        self.shading = [(space, space.shading.color_type) for space in _views()]
+        self.shading = [(space, space.shading.color_type, space.shading.light) for space in _views()]
+        self.saved_views = scene.get(result_state.VIEWS_TAG)
         return self
 
     def retire_results(self):
@@ -138,8 +139,12 @@ class SceneTransaction:
                 data_type, domain, values = saved
                 attr = attrs.new(bake.ATTRIBUTE, data_type, domain)
                 attr.data.foreach_set("color", values)
-        for space, colour in self.shading:
-            space.shading.color_type = colour
+        for space, colour, light in self.shading:
+            space.shading.color_type, space.shading.light = colour, light
+        if self.saved_views is None:
+            self.scene.pop(result_state.VIEWS_TAG, None)
+        else:
+            self.scene[result_state.VIEWS_TAG] = self.saved_views
 
 
 def _copy_attribute(attr):

@@ -203,6 +203,34 @@ class SolveCubeTest(unittest.TestCase):
         after["materials"].remove(bake.MATERIAL_NAME)
         self.assertEqual(after, before)
 
+    def test_the_users_shading_comes_back(self):
+        # A solve shows its result flat-lit with attribute colours; Toggle and
+        # Remove put back how the user had shaded each 3D view.
+        scene = open_scene("cube")
+        views = [s for scr in bpy.data.screens for a in scr.areas for s in a.spaces if s.type == 'VIEW_3D']
+        if not views:
+            self.skipTest("no 3D views in this Blender's file")
+        for space in views:
+            space.shading.color_type, space.shading.light = 'MATERIAL', 'MATCAP'
+
+        def shaded(result):
+            expected = ({'ATTRIBUTE', 'VERTEX'}, {'FLAT'}) if result else ({'MATERIAL'}, {'MATCAP'})
+            return all(s.shading.color_type in expected[0] and s.shading.light in expected[1] for s in views)
+
+        self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
+        self.assertTrue(shaded(True))
+        bpy.ops.radiosity.toggle_result()
+        self.assertTrue(shaded(False))
+        bpy.ops.radiosity.toggle_result()
+        self.assertTrue(shaded(True))
+        self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})  # a second solve saves nothing new
+        bpy.ops.radiosity.clear()
+        self.assertTrue(shaded(False))
+        # Without "View Result" the views are left alone.
+        scene.radiosity.view_result = False
+        self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
+        self.assertTrue(shaded(False))
+
     def test_undo_restores(self):
         # Global (memfile) undo works in background mode, but operators called
         # from a script push no undo step of their own (the window manager does

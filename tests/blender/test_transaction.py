@@ -28,12 +28,12 @@ from test_solve import open_scene
 # as (module, function).
 STEPS = {
     'REFINED': ((bake, "write_refined"), (result_state, "hide_originals"), (result_state, "show_results"),
-                (bake, "set_viewport_attribute_colour")),
+                (result_state, "show_in_views")),
     'LIGHTING': ((bake, "write_refined"), (result_state, "hide_originals"), (result_state, "show_results"),
-                 (bake, "set_viewport_attribute_colour")),
+                 (result_state, "show_in_views")),
     'BOTH': ((bake, "write_refined"), (result_state, "hide_originals"), (result_state, "show_results"),
-             (bake, "write_original"), (bake, "set_viewport_attribute_colour")),
-    'ORIGINAL': ((result_state, "restore_originals"), (bake, "write_original"), (bake, "set_viewport_attribute_colour")),
+             (bake, "write_original"), (result_state, "show_in_views")),
+    'ORIGINAL': ((result_state, "restore_originals"), (bake, "write_original"), (result_state, "show_in_views")),
 }
 
 
@@ -93,8 +93,9 @@ def full_state(scene):
                               for o in result_state.result_objects(scene)}
     state["tags"] = {o.name: dict((k, str(o[k])) for k in o.keys() if k.startswith("radiosity"))
                      for o in scene.objects}
-    state["shading"] = [s.shading.color_type for scr in bpy.data.screens for a in scr.areas
-                        for s in a.spaces if s.type == 'VIEW_3D']
+    state["shading"] = [(s.shading.color_type, s.shading.light) for scr in bpy.data.screens
+                        for a in scr.areas for s in a.spaces if s.type == 'VIEW_3D']
+    state["saved shading"] = scene.get(result_state.VIEWS_TAG)
     layer = bpy.context.view_layer
     state["object flags"] = {o.name: (o.hide_render, o.hide_viewport, o.hide_get(view_layer=layer),
                                       o.hide_select) for o in scene.objects}
@@ -257,6 +258,49 @@ class FailingStepsChangeNothing(unittest.TestCase):
                 self.assertEqual(operators.RADIOSITY_OT_solve._conclude(op, bpy.context, job), {'CANCELLED'})
                 self.assertIn("cancelled before the first pass", op.reports[-1][1])
                 self.assertEqual(full_state(scene), before)
+
+    def test_a_failing_interactive_solve_takes_back_the_passes_it_showed(self):
+        """The passes an interactive solve showed live (pipeline.LiveResult) go
+        when it fails, and the previous result comes back; when it succeeds its
+        last pass stands."""
+        for previous in (None, 'REFINED', 'BOTH'):
+            with self.subTest(previous=previous):
+                scene = open_scene("cube")
+                scene.radiosity.quality = 0.3
+                if previous:
+                    scene.radiosity.output = previous
+                    self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
+                for space in (s for scr in bpy.data.screens for a in scr.areas for s in a.spaces
+                              if s.type == 'VIEW_3D'):
+                    space.shading.light = 'MATCAP'
+                before = full_state(scene)
+                solver = native.load()
+                job = pipeline.prepare(bpy.context, solver)
+                job.monitor = solver.ProgressMonitor(pass_results=True)
+                pipeline.work(solver, job, solver.CancelToken())  # on this thread
+                live = pipeline.LiveResult(bpy.context)
+                live.show(bpy.context, job, job.monitor.take_pass_result())
+                self.assertNotEqual(full_state(scene), before, "the pass is shown")
+                job.error = RuntimeError("injected after a pass was shown")
+                with self.assertRaisesRegex(RuntimeError, "injected"):
+                    pipeline.conclude(bpy.context, job, live)
+                self.assertEqual(full_state(scene), before)
+
+    def test_an_interactive_solve_keeps_its_last_pass(self):
+        scene = open_scene("cube")
+        scene.radiosity.quality = 0.3
+        solver = native.load()
+        job = pipeline.prepare(bpy.context, solver)
+        job.monitor = solver.ProgressMonitor(pass_results=True)
+        pipeline.work(solver, job, solver.CancelToken())
+        live = pipeline.LiveResult(bpy.context)
+        live.show(bpy.context, job, job.monitor.take_pass_result())
+        shown = full_state(scene)
+        stats = pipeline.conclude(bpy.context, job, live)
+        self.assertEqual(stats.elements, job.result.stats["leaves"])
+        after = full_state(scene)
+        self.assertEqual(after["result meshes"], shown["result meshes"], "the final result was the last pass")
+        self.assertFalse([o for o in bpy.data.objects if o.name.endswith("(previous radiosity result)")])
 
     def test_a_solve_that_succeeds_is_not_rolled_back(self):
         scene = open_scene("cube")
