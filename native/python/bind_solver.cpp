@@ -388,8 +388,10 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
 
 void bind_solver(py::module_& m) {
   py::register_exception<InsufficientMemory>(m, "InsufficientMemoryError", PyExc_MemoryError);
-  // The options' defaults and limits by name (the add-on's solver_defaults.json holds the same).
-  m.attr("DEFAULTS") = py::module_::import("json").attr("loads")(defaults_json());
+  // The options' defaults and limits by name, as JSON (the add-on's solver_defaults.json).
+  // As text: importing Python's json here would load a library from the machine
+  // (tests/native/test_package.py holds the module to its own).
+  m.attr("DEFAULTS_JSON") = defaults_json();
   py::class_<CancelToken>(
       m, "CancelToken",
       "A flag another thread can set to stop a solve; the solve then returns the "

@@ -4,6 +4,7 @@ Run by tests/run_tests.py inside `blender --background --factory-startup` with
 build/addon on sys.path and the add-on already registered.
 """
 
+import json
 import os
 import tempfile
 import tomllib
@@ -144,7 +145,7 @@ class DefaultsTest(unittest.TestCase):
 
     def test_defaults_are_the_solvers(self):
         """Each setting the solver also has starts at the solver's default (one definition, in C++)."""
-        defaults = native.load().DEFAULTS
+        defaults = json.loads(native.load().DEFAULTS_JSON)
         s = self.settings
         self.assertEqual(s.oracle.lower(), defaults["oracle"])
         self.assertEqual(s.visibility.lower(), defaults["visibility"])

@@ -47,11 +47,12 @@ class ModuleTest(unittest.TestCase):
         import _radiosity
 
         packaged = pathlib.Path(_radiosity.__file__).with_name("solver_defaults.json")
-        self.assertEqual(json.loads(packaged.read_text()), _radiosity.DEFAULTS)
-        self.assertIn(_radiosity.DEFAULTS["oracle"], ("standard", "perceptual", "gradient"))
-        self.assertIn(_radiosity.DEFAULTS["visibility"], ("exact", "sampled"))
-        self.assertTrue(0.0 < _radiosity.DEFAULTS["quality"] <= 1.0)
-        self.assertTrue(1 <= _radiosity.DEFAULTS["rays"] <= _radiosity.DEFAULTS["max_rays"])
+        defaults = json.loads(_radiosity.DEFAULTS_JSON)
+        self.assertEqual(json.loads(packaged.read_text()), defaults)
+        self.assertIn(defaults["oracle"], ("standard", "perceptual", "gradient"))
+        self.assertIn(defaults["visibility"], ("exact", "sampled"))
+        self.assertTrue(0.0 < defaults["quality"] <= 1.0)
+        self.assertTrue(1 <= defaults["rays"] <= defaults["max_rays"])
 
     def test_has_docstring(self):
         import _radiosity

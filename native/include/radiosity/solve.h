@@ -110,7 +110,7 @@ std::string_view stop_reason_name(StopReason reason);
 
 // SolveOptions{} and the limits as a JSON object, by the names above: the
 // defaults the add-on's settings start from (solver_defaults.json, written at
-// build time by native/generate/write_defaults.cpp) and `_radiosity.DEFAULTS`.
+// build time by native/generate/write_defaults.cpp) and `_radiosity.DEFAULTS_JSON`.
 std::string defaults_json();
 
 struct SolveResult;
