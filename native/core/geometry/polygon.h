@@ -41,6 +41,19 @@ inline double polygon_diameter(std::span<const dvec3> polygon) {
   return d;
 }
 
+// The centre of cell (i, j) of an n x n grid over a quad (bilinear in its
+// corners) or a triangle (the square folded onto it along its diagonal, which
+// keeps the points uniform): where coarse checks look between an element's
+// corners and centre.
+inline dvec3 grid_point(const dvec3* corners, int corner_count, int i, int j, int n) {
+  double a = (i + 0.5) / n, b = (j + 0.5) / n;
+  const dvec3* c = corners;
+  if (corner_count == 4)
+    return (1 - a) * (1 - b) * c[0] + a * (1 - b) * c[1] + a * b * c[2] + (1 - a) * b * c[3];
+  if (a + b > 1.0) a = 1.0 - a, b = 1.0 - b;
+  return (1 - a - b) * c[0] + a * c[1] + b * c[2];
+}
+
 // Does the polygon enclose area beyond rounding? Its area normal must exceed
 // 1e-12 of the square of its extent from the first corner: zero-area,
 // collinear and coincident polygons do not, and the kernels need them not to

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/geometry/form_factor.h"
+#include "core/geometry/polygon.h"
 #include "core/visibility/sampled_visibility.h"
 #include "core/visibility/shaft.h"
 #include "core/visibility/visible_polygon.h"
@@ -374,14 +375,7 @@ double DirectLight::probe(const Light& light, const Element& receiver) const {
   double largest = 0.0;
   for (int i = 0; i < 4; ++i) {
     for (int j = 0; j < 4; ++j) {
-      double a = (i + 0.5) / 4.0, b = (j + 0.5) / 4.0;
-      dvec3 x;
-      if (nc == 4) {
-        x = (1 - a) * (1 - b) * c[0] + a * (1 - b) * c[1] + a * b * c[2] + (1 - a) * b * c[3];
-      } else {
-        if (a + b > 1.0) a = 1.0 - a, b = 1.0 - b;
-        x = (1 - a - b) * c[0] + a * c[1] + b * c[2];
-      }
+      const dvec3 x = grid_point(c, nc, i, j, 4);
       double value = 0.0;
       dvec3 to;
       if (light.kind == LightKind::Sun) {

@@ -7,6 +7,7 @@
 
 #include "core/geometry/form_factor.h"
 #include "core/geometry/patch_form_factor.h"
+#include "core/geometry/polygon.h"
 #include "core/solve/timing.h"
 #include "core/visibility/sampled_visibility.h"
 #include "core/visibility/visible_polygon.h"
@@ -132,14 +133,7 @@ double grid_visible_share(const LinkEnds& ends, int corner_count,
   const dvec3* c = ends.receiver_corners;
   for (int i = 0; i < 4; ++i) {
     for (int j = 0; j < 4; ++j) {
-      double a = (i + 0.5) / 4.0, b = (j + 0.5) / 4.0;
-      dvec3 x;
-      if (corner_count == 4) {
-        x = (1 - a) * (1 - b) * c[0] + a * (1 - b) * c[1] + a * b * c[2] + (1 - a) * b * c[3];
-      } else {
-        if (a + b > 1.0) a = 1.0 - a, b = 1.0 - b;  // fold the square onto the triangle: uniform
-        x = (1 - a - b) * c[0] + a * c[1] + b * c[2];
-      }
+      const dvec3 x = grid_point(c, corner_count, i, j, 4);
       visible += visible_form_factor_gradient(x, ends.n, ends.emitter_polygon(), occluders).value;
       open += form_factor(x, ends.n, ends.emitter_polygon());
     }
