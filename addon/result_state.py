@@ -150,16 +150,20 @@ def _attribute_colour(shading):
 def show_in_views(scene):
     """With "View Result" on, solid shading in every 3D view shows the result's
     colours as computed: the colour attribute, lit flat (studio lighting would
-    shade them again and show them darker than the render). How each view was
-    shaded before is saved once, for restore_views."""
+    shade them again and show them darker than the render), back faces culled
+    (each side of a two-sided face is its own polygon, 2e-6 of the scene in
+    front of the other: far below the depth buffer's resolution, so without
+    culling the two fight and a closed box speckles). How each view was shaded
+    before is saved once, for restore_views."""
     if not scene.radiosity.view_result:
         return
     saved = json.loads(scene.get(VIEWS_TAG, "{}"))
     for key, space in _views():
         shading = space.shading
-        saved.setdefault(key, [shading.color_type, shading.light])
+        saved.setdefault(key, [shading.color_type, shading.light, shading.show_backface_culling])
         shading.color_type = _attribute_colour(shading)
         shading.light = 'FLAT'
+        shading.show_backface_culling = True
     scene[VIEWS_TAG] = json.dumps(saved)
 
 
@@ -168,7 +172,8 @@ def restore_views(scene):
     saved = json.loads(scene.get(VIEWS_TAG, "{}"))
     for key, space in _views():
         if key in saved:
-            space.shading.color_type, space.shading.light = saved[key]
+            shading = space.shading
+            shading.color_type, shading.light, shading.show_backface_culling = saved[key]
     scene.pop(VIEWS_TAG, None)
 
 

@@ -54,7 +54,8 @@ class SceneTransaction:
                 attr = obj.data.color_attributes.get(bake.ATTRIBUTE)
                 self.attributes[obj.data] = (None if attr is None else _copy_attribute(attr),
                                              obj.data.get(ORIGINAL_ATTRIBUTE_TAG))
-        self.shading = [(space, space.shading.color_type, space.shading.light) for space in _views()]
+        self.shading = [(space, space.shading.color_type, space.shading.light,
+                         space.shading.show_backface_culling) for space in _views()]
         self.saved_views = scene.get(result_state.VIEWS_TAG)
         return self
 
@@ -139,8 +140,9 @@ class SceneTransaction:
                 data_type, domain, values = saved
                 attr = attrs.new(bake.ATTRIBUTE, data_type, domain)
                 attr.data.foreach_set("color", values)
-        for space, colour, light in self.shading:
-            space.shading.color_type, space.shading.light = colour, light
+        for space, colour, light, culling in self.shading:
+            shading = space.shading
+            shading.color_type, shading.light, shading.show_backface_culling = colour, light, culling
         if self.saved_views is None:
             self.scene.pop(result_state.VIEWS_TAG, None)
         else:

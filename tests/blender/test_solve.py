@@ -212,10 +212,12 @@ class SolveCubeTest(unittest.TestCase):
             self.skipTest("no 3D views in this Blender's file")
         for space in views:
             space.shading.color_type, space.shading.light = 'MATERIAL', 'MATCAP'
+            space.shading.show_backface_culling = False
 
         def shaded(result):
-            expected = ({'ATTRIBUTE', 'VERTEX'}, {'FLAT'}) if result else ({'MATERIAL'}, {'MATCAP'})
-            return all(s.shading.color_type in expected[0] and s.shading.light in expected[1] for s in views)
+            expected = ({'ATTRIBUTE', 'VERTEX'}, {'FLAT'}, True) if result else ({'MATERIAL'}, {'MATCAP'}, False)
+            return all(s.shading.color_type in expected[0] and s.shading.light in expected[1]
+                       and s.shading.show_backface_culling == expected[2] for s in views)
 
         self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
         self.assertTrue(shaded(True))

@@ -93,7 +93,8 @@ def full_state(scene):
                               for o in result_state.result_objects(scene)}
     state["tags"] = {o.name: dict((k, str(o[k])) for k in o.keys() if k.startswith("radiosity"))
                      for o in scene.objects}
-    state["shading"] = [(s.shading.color_type, s.shading.light) for scr in bpy.data.screens
+    state["shading"] = [(s.shading.color_type, s.shading.light, s.shading.show_backface_culling)
+                        for scr in bpy.data.screens
                         for a in scr.areas for s in a.spaces if s.type == 'VIEW_3D']
     state["saved shading"] = scene.get(result_state.VIEWS_TAG)
     layer = bpy.context.view_layer
