@@ -91,10 +91,12 @@ def progress_texts(progress):
     if not progress:
         return "Starting", "Starting", ""
     seconds = duration(float(progress.get("seconds", 0.0)))
-    if progress.get("phase") == "linking" or not progress.get("passes"):
+    passes = progress.get("passes", 0)
+    if progress.get("phase") == "linking" or not passes:
         where = "Preparing"
     else:
-        where = "Pass {} of {}".format(max(1, progress.get("pass", 0)), progress["passes"])
+        # `pass` counts from 0: the pass being refined, or the one just completed.
+        where = "Pass {} of {}".format(min(progress.get("pass", 0) + 1, passes), passes)
     leaves = progress.get("leaves", progress.get("elements", 0))
     count = "{:,} elements".format(leaves) if leaves else ""
     return " · ".join(t for t in (where, count, seconds) if t), "%s · %s" % (where, seconds), count

@@ -38,7 +38,7 @@ addon_utils.enable("radiosity", default_set=False, handle_error=fail)
 from radiosity import operators, result_state  # noqa: E402  (the add-on, enabled above)
 
 # The progress dict an interactive solve reports (operators.running_progress).
-FAKE_PROGRESS = {"fraction": 0.43, "pass": 3, "passes": 7, "leaves": 12316, "elements": 24631,
+FAKE_PROGRESS = {"fraction": 0.43, "pass": 2, "passes": 7, "leaves": 12316, "elements": 24631,
                  "links": 402113, "seconds": 4.2, "phase": "pass"}
 state = {"step": 0, "files": [], "result": {}}
 saved_progress = operators.running_progress

@@ -34,7 +34,7 @@ PANELS = (ui.RENDER_PT_radiosity, ui.RENDER_PT_radiosity_quality, ui.RENDER_PT_r
           ui.RENDER_PT_radiosity_stats)
 MENU_OPERATORS = ["radiosity.solve", "radiosity.toggle_result", "radiosity.clear"]
 # What a running solve reports (operators.running_progress).
-PROGRESS = {"fraction": 0.43, "pass": 3, "passes": 7, "leaves": 12316, "elements": 24631,
+PROGRESS = {"fraction": 0.43, "pass": 2, "passes": 7, "leaves": 12316, "elements": 24631,
             "links": 402113, "seconds": 4.2, "phase": "pass"}
 
 
@@ -415,7 +415,7 @@ class PanelTest(unittest.TestCase):
 
     def test_progress_fits_the_default_width(self):
         for progress in (PROGRESS, {}, dict(PROGRESS, phase="linking", passes=0, fraction=0.02),
-                         dict(PROGRESS, leaves=98765432, seconds=12345.6, passes=17, **{"pass": 17})):
+                         dict(PROGRESS, leaves=98765432, seconds=12345.6, passes=17, **{"pass": 16})):
             with self.subTest(progress=progress), self.running(progress):
                 layout = self.draw()
                 self.assert_fits(layout)
@@ -429,6 +429,9 @@ class PanelTest(unittest.TestCase):
         self.assertEqual(ui.progress_texts(dict(PROGRESS, phase="linking", passes=0, leaves=0))[:2],
                          ("Preparing · 4.2 s", "Preparing · 4.2 s"))
         self.assertEqual(ui.progress_texts(dict(PROGRESS, seconds=3725.2))[1], "Pass 3 of 7 · 1:02:05")
+        # `pass` counts from 0; after the last pass (phase done) it is the pass count.
+        self.assertEqual(ui.progress_texts(dict(PROGRESS, phase="refining", **{"pass": 0}))[1], "Pass 1 of 7 · 4.2 s")
+        self.assertEqual(ui.progress_texts(dict(PROGRESS, phase="done", **{"pass": 7}))[1], "Pass 7 of 7 · 4.2 s")
 
     def test_warns_when_a_result_object_is_selected(self):
         mesh = bpy.data.meshes.new("result mesh")
