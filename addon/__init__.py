@@ -15,8 +15,11 @@ bl_info = {
     "author": "Radiosity for Blender contributors",
     "version": (0, 1, 0),
     "blender": (3, 4, 0),
-    "location": "Properties > Render > Radiosity",
+    "location": "Properties > Render > Radiosity; Render menu; 3D View > View > Radiosity",
     "description": "Hierarchical radiosity with perceptual refinement, baked into colour attributes",
+    # No project site yet: the README of the repository (placeholder address).
+    "doc_url": "https://github.com/radiosity-for-blender/radiosity#radiosity-for-blender",
+    "tracker_url": "https://github.com/radiosity-for-blender/radiosity/issues",
     "category": "Render",
 }
 
@@ -43,7 +46,12 @@ classes = (
     operators.RADIOSITY_OT_toggle_result,
     operators.RADIOSITY_OT_clear,
     game_export.RADIOSITY_OT_export_gltf,
+    # The parent panel before its sub-panels, which show in this order.
     ui.RENDER_PT_radiosity,
+    ui.RENDER_PT_radiosity_quality,
+    ui.RENDER_PT_radiosity_output,
+    ui.RENDER_PT_radiosity_stats,
+    ui.VIEW3D_MT_radiosity,
 )
 
 
@@ -55,6 +63,7 @@ def register():
         name="Radiosity",
         description="Radiosity solver settings",
     )
+    ui.register()  # menu entries, the progress bar's property
     # Try the native module now so the panel can say at once if it is unusable;
     # registration itself never depends on it.
     try:
@@ -64,6 +73,7 @@ def register():
 
 
 def unregister():
+    ui.unregister()
     del bpy.types.Scene.radiosity
     for cls in reversed(classes):
         bpy.utils.unregister_class(cls)

@@ -6,7 +6,7 @@ the vertex before the surface's reflectance and emission, H (radiance =
 emission + reflectance x H, DESIGN.md section 3), and the original's UV maps
 under their names (interpolated onto the result's corners, surface_uv.py).
 
-Output "Lighting Only (Keep Materials)" gives each result object copies of its
+Output "Lit Materials" ('LIGHTING') gives each result object copies of its
 original's materials (the originals are never edited), each rewritten to emit
 what the surface shows under the solved light: every diffuse BSDF becomes an
 Emission shader of its colour source (Principled Base Color, Diffuse Color,

@@ -104,3 +104,9 @@ def set_name(collection, block, name):
             block.name = candidate
             return
         number += 1
+
+
+def has_progress_bar(layout):
+    """Whether the layout draws progress bars (UILayout.progress, Blender 4.0+); before,
+    the panel draws one of its own (ui.draw_progress)."""
+    return hasattr(layout, "progress")

@@ -216,11 +216,11 @@ def export_gltf(context, filepath):
         filepath += ".glb"
     objects = [o for o in result_state.result_objects(scene) if view_layer.objects.get(o.name) is not None]
     if not objects:
-        raise RuntimeError("No radiosity result to export: solve with output Refined Meshes first")
+        raise RuntimeError("No radiosity result to export: solve with output New Meshes first")
     not_ready = [o.name for o in objects if not is_game_ready(o)]
     if not_ready:
         raise RuntimeError("The result holds HDR radiance, not display colours: tick Game-Ready "
-                           "Colours and solve again before exporting (%s)" % ", ".join(not_ready[:3]))
+                           "Colours (Radiosity > Output: Colours For Games) and solve again before exporting (%s)" % ", ".join(not_ready[:3]))
     props = gltf_exporter_properties()
     if props is None:
         raise RuntimeError("The glTF exporter (io_scene_gltf2) is not available in this Blender")
@@ -231,10 +231,12 @@ def export_gltf(context, filepath):
         for obj in selected:
             obj.select_set(False, view_layer=view_layer)
         for obj in objects:
-            # Results hidden by Toggle are still the ones to export.
-            hidden[obj.name] = (obj.hide_viewport, obj.hide_get(view_layer=view_layer))
+            # Results hidden by Toggle are still the ones to export, and results are
+            # not selectable (bake.write_refined) until made so for the exporter.
+            hidden[obj.name] = (obj.hide_viewport, obj.hide_get(view_layer=view_layer), obj.hide_select)
             obj.hide_viewport = False
             obj.hide_set(False, view_layer=view_layer)
+            obj.hide_select = False
             obj.select_set(True, view_layer=view_layer)
         view_layer.objects.active = objects[0]
         options = gltf_options(props, filepath)
@@ -247,6 +249,7 @@ def export_gltf(context, filepath):
             if obj.name in hidden:
                 obj.hide_viewport = hidden[obj.name][0]
                 obj.hide_set(hidden[obj.name][1], view_layer=view_layer)
+                obj.hide_select = hidden[obj.name][2]
         for obj in selected:
             if view_layer.objects.get(obj.name) is not None:
                 obj.select_set(True, view_layer=view_layer)

@@ -4,16 +4,19 @@ The module is a binary built for one Python version and linked against the
 system's shared libraries, so importing it can fail on a machine it was not
 built for. Registration must not depend on it (the panel should still appear
 and explain the problem), so the import is attempted lazily, once, and the
-error is kept to be reported by whoever needs the solver.
+error is kept to be reported by whoever needs the solver, with what to do
+about it: rebuild, in a source build; reinstall the right zip, otherwise.
 """
 
 import importlib
 import pathlib
+import platform
 import re
 import sys
 
 _module = None
 _error = None
+_advice = None
 
 
 class NativeUnavailable(RuntimeError):
@@ -25,25 +28,57 @@ def load():
 
     Raises NativeUnavailable with a message fit for a user report.
     """
-    global _module, _error
+    global _module, _error, _advice
     if _module is None and _error is None:
         try:
             _module = importlib.import_module("._radiosity", __package__)
         except ImportError as err:
-            _error = (
-                "Radiosity native module could not be loaded: %s "
-                "(it is built for Python %s; rebuild the add-on with `make` "
-                "for this Blender, whose Python is %d.%d)"
-                % (err, _built_for(), *sys.version_info[:2])
-            )
+            _advice = what_to_do(source_build())
+            _error = "Radiosity native module could not be loaded: %s (%s)" % (err, _advice)
     if _module is None:
         raise NativeUnavailable(_error)
     return _module
 
 
+def source_build(folder=None):
+    """Whether the package runs from a source build (BUILD/addon/radiosity, with
+    BUILD/CMakeCache.txt) rather than from an installed zip."""
+    folder = pathlib.Path(folder or pathlib.Path(__file__).parent).resolve()
+    return (folder.parent.parent / "CMakeCache.txt").is_file()
+
+
+def what_to_do(from_source):
+    """What a user can do about a module that does not load: rebuild (a source build)
+    or install the zip made for their Blender (an installed zip)."""
+    built, running = _built_for(), "%d.%d" % sys.version_info[:2]
+    if from_source:
+        return ("it is built for Python %s; rebuild the add-on with `make` for this Blender, "
+                "whose Python is %s" % (built, running))
+    here = "Python %s" % running
+    if (platform.system(), platform.machine()) != ("Linux", "x86_64"):
+        here += " on %s %s" % (platform.system(), platform.machine())
+    return ("this copy is built for Linux x64 and Python %s, and this Blender runs %s. "
+            "Reinstall the add-on from the zip for Linux x64 and your Blender: "
+            "radiosity-%s-linux_x64.zip (the extension) for Blender 4.2 and later, "
+            "radiosity-%s-legacy_linux_x64.zip for Blender 3.4 to 4.1. Both need a Blender "
+            "whose Python is %s; others need a build of their own (README, "
+            "\"Which Blender a build works in\")" % (built, here, _version(), _version(), built))
+
+
 def error():
     """The import error message, or None when the module loaded (or was never tried)."""
     return _error
+
+
+def advice():
+    """What to do about the import error, or None when the module loaded (or was never tried)."""
+    return _advice
+
+
+def _version():
+    package = sys.modules.get(__package__)
+    version = getattr(package, "bl_info", {}).get("version")
+    return ".".join(map(str, version)) if version else "VERSION"
 
 
 def version():

@@ -26,39 +26,47 @@ from bpy.types import PropertyGroup
 # module cannot load.
 SOLVER_DEFAULTS = json.loads(pathlib.Path(__file__).with_name("solver_defaults.json").read_text())
 
+# Names are short enough to show uncut at the default Properties width (the
+# Blender tests measure them); descriptions say what a choice does to the
+# picture and the time, with the technical name last.
 ORACLE_ITEMS = (
     ('STANDARD', "Standard",
-     "Refine where the form factor varies over the receiver times the emitter's "
-     "power (Hanrahan et al. BF refinement)"),
+     "Adds detail wherever much light arrives unevenly, whether or not it shows: "
+     "dependable, but spends elements and time on bright areas that already look "
+     "smooth (Hanrahan et al.'s BF refinement)"),
     ('PERCEPTUAL', "Perceptual",
-     "Refine where linear interpolation of radiance across an element would be "
-     "visibly wrong, judged from irradiance gradients (Secchia 2000)"),
-    ('GRADIENT', "Gradient Difference",
-     "Refine where the irradiance gradient changes across the receiver"),
+     "Adds detail only where the eye would see the shading go wrong, at shadow edges "
+     "and hot spots, and leaves smooth areas coarse: the best picture for the time "
+     "(Secchia 2000, judged from irradiance gradients)"),
+    ('GRADIENT', "Gradient",
+     "Adds detail where the shading changes how quickly it brightens or darkens, as in "
+     "penumbrae and light falloff (irradiance gradient difference)"),
 )
 
 VISIBILITY_ITEMS = (
     ('EXACT', "Exact",
-     "Clip each emitter against its occluders as seen from every sample point; "
-     "exact shadows and gradients, slower"),
+     "Shadows computed exactly: clean edges and smooth penumbrae; slower in "
+     "cluttered scenes (each light clipped against its occluders)"),
     ('SAMPLED', "Sampled",
-     "Estimate the visible fraction of each emitter with shadow rays; faster, "
-     "noisier penumbrae, gradients ignore occluders"),
+     "Shadows estimated with rays: faster in cluttered scenes, slightly noisy "
+     "penumbrae (more Rays, less noise), and shadow edges may get less detail "
+     "(the oracles' gradients ignore occluders)"),
 )
 
 OUTPUT_ITEMS = (
-    ('REFINED', "Refined Meshes",
-     "Write new meshes that carry the adaptive refinement into a 'Radiosity' "
-     "collection, leaving the originals untouched"),
-    ('ORIGINAL', "Original Meshes",
-     "Write a face-corner 'Radiosity' colour attribute onto the original meshes, "
-     "without refinement"),
+    ('REFINED', "New Meshes",
+     "Adds lit copies of the objects, finely divided where the light changes, in a "
+     "'Radiosity' collection and shows them instead of the originals, which stay "
+     "untouched (Toggle Result switches back)"),
+    ('ORIGINAL', "On Originals",
+     "Stores the light on the original meshes as a 'Radiosity' colour attribute: no "
+     "new objects, but only as much detail as the meshes' own vertices"),
     ('BOTH', "Both",
-     "Write refined meshes and the attribute on the original meshes"),
-    ('LIGHTING', "Lighting Only (Keep Materials)",
-     "Write refined meshes like Refined Meshes, each with copies of its original's "
-     "materials (textures included) lit by the solution's 'Radiosity Light' attribute "
-     "(the light before the surface's colour); the originals are untouched"),
+     "New meshes, and the colour attribute on the original meshes"),
+    ('LIGHTING', "Lit Materials",
+     "Like New Meshes, but each copy keeps its original's materials and textures, lit "
+     "by the solution: the surface colour comes from the material, the light from "
+     "the solve ('Radiosity Light' attribute); the originals are untouched"),
 )
 
 
@@ -67,41 +75,41 @@ class RadiosityStats(PropertyGroup):
 
     valid: BoolProperty(
         name="Solved",
-        description="Whether this scene has been solved since the settings were created",
+        description="Whether this scene has been solved since its settings were made",
         default=False,
     )
     status: StringProperty(
         name="Status",
-        description="How the last solve ended (converged, budget reached, cancelled)",
+        description="How the last solve ended: converged, stopped at a limit, or cancelled",
     )
     oracle: StringProperty(
         name="Oracle",
-        description="Refinement oracle used by the last solve",
+        description="The oracle the last solve used",
     )
     elements: IntProperty(
         name="Elements",
-        description="Leaf elements of the hierarchy after the last solve",
+        description="Elements (mesh pieces) of the last solve's result",
         min=0,
     )
     links: IntProperty(
         name="Links",
-        description="Interaction links after the last solve",
+        description="Pairs of elements the last solve exchanged light between (links)",
         min=0,
     )
     iterations: IntProperty(
         name="Iterations",
-        description="Refine-gather-push/pull iterations of the last solve",
+        description="Light-gathering iterations of the last solve (refine-gather-push/pull)",
         min=0,
     )
     seconds: FloatProperty(
         name="Time",
-        description="Wall-clock time of the last solve",
+        description="How long the last solve took",
         min=0.0,
         unit='TIME_ABSOLUTE',
     )
     warning: StringProperty(
         name="Warning",
-        description="What the last solve could not model (for example point lights)",
+        description="What the last solve could not model (for example point lights), and other notes",
     )
 
     def clear(self):
@@ -123,17 +131,22 @@ class RadiositySettings(PropertyGroup):
 
     oracle: EnumProperty(
         name="Oracle",
-        description="How the solver decides where to refine the mesh",
+        description=(
+            "Where the lighting gets more detail: where the eye would notice (Perceptual), "
+            "wherever much light varies (Standard) or where the shading's slope changes "
+            "(Gradient). Technically, the refinement oracle"
+        ),
         items=ORACLE_ITEMS,
         default=SOLVER_DEFAULTS["oracle"].upper(),
     )
     quality: FloatProperty(
         name="Quality",
         description=(
-            "How finely to refine, from 0 (coarse and fast) to 1 (fine and slow). "
-            "Each oracle maps it to its own refinement threshold relative to the "
-            "scene's emitted power and area, so the same value gives comparable "
-            "results in scenes of any scale or brightness"
+            "How much detail the lighting gets: low values are fast, with soft, blocky "
+            "shadows; high values resolve sharp shadow edges and small features but take "
+            "much longer and make heavier meshes. The same value looks alike in scenes of "
+            "any size or brightness (each oracle's threshold is relative to the scene's "
+            "emitted power and area)"
         ),
         min=0.0,
         max=1.0,
@@ -141,31 +154,32 @@ class RadiositySettings(PropertyGroup):
         subtype='FACTOR',
     )
     max_elements: IntProperty(
-        name="Max Elements",
+        name="Elements",
         description=(
-            "Stop refining when the hierarchy has this many leaf elements and "
-            "keep the best solution so far (0 for no limit)"
+            "Most elements (pieces of the result's meshes) to make: the solve stops adding "
+            "detail there and keeps the best lighting so far, which bounds its memory, the "
+            "mesh size and the time. 0: no limit"
         ),
         min=0,
         default=0,
     )
     time_budget: FloatProperty(
-        name="Time Budget",
+        name="Time Limit",
         description=(
             "Stop after about this many seconds, reading the scene and writing the result "
-            "included, and keep the best solution so far (0 for no limit)"
+            "included, and keep the best lighting so far. 0: no limit"
         ),
         min=0.0,
         default=0.0,
         unit='TIME_ABSOLUTE',
     )
     min_element_size: FloatProperty(
-        name="Smallest Element",
+        name="Min Size",
         description=(
-            "Elements are not split below this edge length (0: automatic, elements down "
-            "to 1/%s of the scene's surface area). The perceptual and gradient "
-            "oracles refine the thin shadows of chair and table legs down to this "
-            "size at any quality, so in furnished rooms it sets their cost"
+            "Surfaces are never divided finer than this edge length. Raise it to save time "
+            "in furnished rooms: the Perceptual and Gradient oracles follow the thin shadows "
+            "of chair and table legs down to this size at any quality. 0: automatic, "
+            "elements down to 1/%s of the scene's surface area"
         ) % format(round(1.0 / SOLVER_DEFAULTS["min_element_area"]), ","),
         min=0.0,
         default=0.0,
@@ -173,23 +187,31 @@ class RadiositySettings(PropertyGroup):
     )
     visibility: EnumProperty(
         name="Visibility",
-        description="How occlusion between surfaces is computed",
+        description="How shadows are computed: exactly, or estimated with rays",
         items=VISIBILITY_ITEMS,
         default=SOLVER_DEFAULTS["visibility"].upper(),
     )
     rays: IntProperty(
         name="Rays",
-        description="Shadow rays per sample point and emitter for sampled visibility",
+        description=(
+            "Rays from each point toward each light, for Sampled visibility: more give "
+            "smoother penumbrae and take longer"
+        ),
         min=1,
         soft_max=256,
         max=SOLVER_DEFAULTS["max_rays"],
         default=SOLVER_DEFAULTS["rays"],
     )
+    # Scripts set it as `bounces`; the UI does not call it that, since Cycles' Bounces
+    # count reflections and its 0 means direct light only.
     bounces: IntProperty(
-        name="Bounces",
+        name="Iterations",
         description=(
-            "Number of refine-gather-push/pull iterations (0 to iterate until "
-            "the radiance converges)"
+            "Not Cycles' light bounces. 0 (the default) repeats until the lighting has "
+            "converged, adding detail pass by pass: the full solution. A number N runs one "
+            "pass of exactly N light-gathering iterations, so light reflects at most N times "
+            "(1: direct light only): quicker, but darker where light arrives indirectly. "
+            "Technically, refine-gather-push/pull iterations"
         ),
         min=0,
         soft_max=16,
@@ -197,13 +219,16 @@ class RadiositySettings(PropertyGroup):
     )
     output: EnumProperty(
         name="Output",
-        description="Where the solution is written",
+        description="Where the lighting is written: new meshes, the originals, or both",
         items=OUTPUT_ITEMS,
         default='REFINED',
     )
     show_wireframe: BoolProperty(
-        name="Show Elements",
-        description="Show the edges of the refined elements in the viewport",
+        name="Wireframe",
+        description=(
+            "Show the edges of the result's elements in the viewport, to see where the "
+            "solve added detail"
+        ),
         default=False,
         update=_update_wireframe,
     )
@@ -211,18 +236,18 @@ class RadiositySettings(PropertyGroup):
     display_colours: BoolProperty(
         name="Game-Ready Colours",
         description=(
-            "Bake display-ready colours for game engines instead of radiance: exposure, "
-            "the scene's view transform (Color Management) and a clamp to 0-1, shown "
-            "through an unlit material that the glTF exporter writes as KHR_materials_unlit "
-            "with the colours as COLOR_0 (not with Lighting Only, which keeps the materials)"
+            "Bake colours ready to show in a game engine instead of light values: exposure "
+            "and the scene's view transform (Color Management) applied, clamped to 0-1 and "
+            "shown unlit, exported to glTF as vertex colours (COLOR_0 with "
+            "KHR_materials_unlit). Not with Lit Materials, which keeps the materials"
         ),
         default=False,
     )
     display_exposure: FloatProperty(
         name="Exposure",
         description=(
-            "Exposure of the game-ready colours in stops (radiance times 2^exposure), "
-            "added to the scene's Color Management exposure"
+            "Brightens (positive) or darkens (negative) the game-ready colours, in stops "
+            "(radiance times 2^exposure), on top of the scene's Color Management exposure"
         ),
         soft_min=-10.0,
         soft_max=10.0,

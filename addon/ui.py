@@ -1,25 +1,204 @@
-"""The Radiosity panel in Properties > Render.
+"""The Radiosity panels in Properties > Render, and the add-on's menu entries.
 
-Drawing only reads settings; it never changes data or calls operators.
+The parent panel holds the Solve button (with a progress bar while a solve
+runs) and Toggle / Remove; its sub-panels hold the settings (Quality and
+Limits, Output) and the last solve's Statistics. Solve, Toggle and Remove are
+also in the Render menu and in the 3D view's View > Radiosity menu, which is
+where F3 search finds them.
+
+Drawing only reads settings and the running solve's progress; it never changes
+data or calls operators. It is cheap: the operator redraws the panel while a
+solve runs. Labels are short enough for the default Properties width
+(tests/blender/test_addon.py measures them); longer text (errors, warnings,
+statuses) is wrapped to the region's width.
 """
 
-from bpy.types import Panel
+import textwrap
 
-from . import native
+import bpy
+from bpy.props import FloatProperty
+from bpy.types import Menu, Panel
+
+from . import compat, native, operators, result_state
+
+EDIT_WARNING = "Edits to radiosity results are replaced by the next Solve"
+# Width of a character of the UI font at scale 1, above the widest lines of the texts
+# drawn here (5.4 px in 3.x's DejaVu Sans; 4.x's Inter is a little wider), what a
+# panel's layout is narrower than its region, and the room around a label's text,
+# an icon and a box's margins take: wrapped lines fit, cut at words.
+CHAR_WIDTH = 6.0
+PANEL_MARGIN = 33
+LABEL_PAD = 5
+ICON_WIDTH = 20
+BOX_PAD = 10
+# A slider's value beside its text (the progress bar before 4.0).
+SLIDER_VALUE = 40
 
 
-class RENDER_PT_radiosity(Panel):
-    """Radiosity solver settings, the Solve button and the last solve's statistics"""
+def region_width(context):
+    """The drawing region's width in pixels at UI scale 1, or None outside a region."""
+    region = getattr(context, "region", None)
+    if region is None:
+        return None
+    scale = context.preferences.system.ui_scale or 1.0  # 0 without a window (3.4)
+    return region.width / scale
 
-    bl_label = "Radiosity"
+
+def wrap(text, context, indent=0):
+    """`text` in lines that fit the region less `indent` pixels (one line when the
+    width is unknown)."""
+    width = region_width(context)
+    if width is None:
+        return [text]
+    chars = max(16, int((width - PANEL_MARGIN - LABEL_PAD - indent) / CHAR_WIDTH))
+    return textwrap.wrap(text, chars) or [text]
+
+
+def draw_wrapped(layout, context, text, icon='NONE', indent=0):
+    """Labels of `text` wrapped to the region, the icon on the first line; `indent`:
+    what the layout is narrower than the panel (BOX_PAD in a box)."""
+    col = layout.column(align=True)
+    if icon != 'NONE':
+        indent += ICON_WIDTH
+    for index, line in enumerate(wrap(text, context, indent)):
+        col.label(text=line, icon=icon if index == 0 or icon == 'NONE' else 'BLANK1')
+    return col
+
+
+def fits(text, context, indent=0):
+    return len(wrap(text, context, indent)) == 1
+
+
+# --- Progress ---------------------------------------------------------------------------
+
+def progress_fraction(progress):
+    return min(max(float(progress.get("fraction", 0.0)), 0.0), 1.0) if progress else 0.0
+
+
+def duration(seconds):
+    """4.2 s, 3:25 or 3:25:45: short enough for the progress bar of a long solve."""
+    if seconds < 60:
+        return "%.1f s" % seconds
+    minutes, secs = divmod(int(seconds), 60)
+    return "%d:%02d" % (minutes, secs) if minutes < 60 else "%d:%02d:%02d" % (minutes // 60, minutes % 60, secs)
+
+
+def progress_texts(progress):
+    """The progress bar's text in full ("Pass 3 of 7 · 12,316 elements · 4.2 s") and
+    short, without the count ("Pass 3 of 7 · 4.2 s"), and the count ("12,316
+    elements", "" before there is one). Elements are leaves, the count the final
+    statistics give."""
+    if not progress:
+        return "Starting", "Starting", ""
+    seconds = duration(float(progress.get("seconds", 0.0)))
+    passes = progress.get("passes", 0)
+    if progress.get("phase") == "linking" or not passes:
+        where = "Preparing"
+    else:
+        # `pass` counts from 0: the pass being refined, or the one just completed.
+        where = "Pass {} of {}".format(min(progress.get("pass", 0) + 1, passes), passes)
+    leaves = progress.get("leaves", progress.get("elements", 0))
+    count = "{:,} elements".format(leaves) if leaves else ""
+    return " · ".join(t for t in (where, count, seconds) if t), "%s · %s" % (where, seconds), count
+
+
+def _progress_percent(wm):
+    # The fallback bar's value: read from the running solve, never stored.
+    return 100.0 * progress_fraction(operators.running_progress())
+
+
+def _ignore(wm, value):
+    pass  # a bar, not a setting: dragging it changes nothing
+
+
+# Where UILayout has no progress bar (before 4.0) a slider of this property is one:
+# a fill to the fraction with the text over it. A setter that ignores the value keeps
+# it drawn live rather than greyed out as a read-only property would be.
+PROGRESS_PROPERTY = FloatProperty(
+    name="Progress",
+    description="How far the running radiosity solve is",
+    subtype='PERCENTAGE',
+    min=0.0,
+    max=100.0,
+    precision=0,
+    get=_progress_percent,
+    set=_ignore,
+)
+
+
+def draw_progress(layout, context, progress):
+    """The running solve's progress bar and counts, with how to stop it."""
+    full, short, count = progress_texts(progress)
+    col = layout.column(align=True)
+    bar = col.column(align=True)
+    native_bar = compat.has_progress_bar(bar)
+    text = full if fits(full, context, indent=0 if native_bar else SLIDER_VALUE) else short
+    if native_bar:
+        bar.progress(factor=progress_fraction(progress), type='BAR', text=text)
+    else:
+        bar.prop(context.window_manager, "radiosity_progress", slider=True, text=text)
+    if text == short and count:
+        col.label(text=count)  # below the bar where the bar has no room for it
+    col.label(text="Esc to cancel", icon='CANCEL')
+
+
+# --- Panels -----------------------------------------------------------------------------
+
+class RadiosityPanel:
     bl_space_type = 'PROPERTIES'
     bl_region_type = 'WINDOW'
     bl_context = "render"
+
+
+def result_selected(context):
+    """Whether the user selected a generated result object (possible through the
+    Outliner, or after making it selectable)."""
+    objects = context.view_layer.objects
+    active = objects.active
+    if active is not None and active.get(result_state.RESULT_TAG):
+        return True
+    return any(o.get(result_state.RESULT_TAG) for o in objects.selected)
+
+
+class RENDER_PT_radiosity(RadiosityPanel, Panel):
+    """Solve, the progress of a running solve, and the result's Toggle and Remove"""
+
+    bl_label = "Radiosity"
 
     @classmethod
     def poll(cls, context):
         # Shown for every render engine: the result is plain colour attributes.
         return context.scene is not None
+
+    def draw(self, context):
+        layout = self.layout
+        col = layout.column()
+        row = col.row()
+        row.scale_y = 1.5
+        row.operator("radiosity.solve", icon='LIGHT_AREA')
+        progress = operators.running_progress()
+        if progress is not None:
+            draw_progress(col, context, progress)
+        # Side by side where they fit, else one above the other.
+        flow = layout.grid_flow(row_major=True, columns=0, even_columns=True, align=True)
+        flow.operator("radiosity.toggle_result", text="Toggle Result", icon='HIDE_OFF')
+        flow.operator("radiosity.clear", text="Remove Result", icon='X')
+        advice = native.advice()
+        if advice is not None:
+            box = layout.box()
+            box.alert = True
+            box.label(text="Solver failed to load", icon='ERROR')
+            draw_wrapped(box, context, advice, indent=BOX_PAD)
+        if result_selected(context):
+            box = layout.box()
+            draw_wrapped(box, context, EDIT_WARNING, icon='ERROR', indent=BOX_PAD)
+
+
+class RENDER_PT_radiosity_quality(RadiosityPanel, Panel):
+    """How much detail the lighting gets and where, and when the solve stops"""
+
+    bl_label = "Quality and Limits"
+    bl_parent_id = "RENDER_PT_radiosity"
 
     def draw(self, context):
         settings = context.scene.radiosity
@@ -30,11 +209,6 @@ class RENDER_PT_radiosity(Panel):
         col = layout.column()
         col.prop(settings, "oracle")
         col.prop(settings, "quality", slider=True)
-
-        col = layout.column(heading="Limits", align=True)
-        col.prop(settings, "max_elements")
-        col.prop(settings, "time_budget")
-        col.prop(settings, "bounces")
         col.prop(settings, "min_element_size")
 
         col = layout.column()
@@ -43,43 +217,111 @@ class RENDER_PT_radiosity(Panel):
         sub.active = settings.visibility == 'SAMPLED'
         sub.prop(settings, "rays")
 
+        col = layout.column(align=True)
+        col.prop(settings, "max_elements")
+        col.prop(settings, "time_budget")
+        col.prop(settings, "bounces")
+
+
+class RENDER_PT_radiosity_output(RadiosityPanel, Panel):
+    """Where the lighting is written, and colours for game engines"""
+
+    bl_label = "Output"
+    bl_parent_id = "RENDER_PT_radiosity"
+
+    def draw(self, context):
+        settings = context.scene.radiosity
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+
         col = layout.column()
         col.prop(settings, "output")
         col.prop(settings, "show_wireframe")
 
-        col = layout.column(heading="Game Export")
+        col = layout.column(heading="Colours")
         col.active = settings.output != 'LIGHTING'  # it keeps the materials: nothing to make unlit
-        col.prop(settings, "display_colours")
+        col.prop(settings, "display_colours", text="For Games")
         sub = col.column()
         sub.active = settings.display_colours
         sub.prop(settings, "display_exposure")
-
-        layout.separator()
-        row = layout.row()
-        row.scale_y = 1.5
-        row.operator("radiosity.solve", icon='LIGHT_AREA')
-        row = layout.row(align=True)
-        row.operator("radiosity.toggle_result", icon='HIDE_OFF')
-        row.operator("radiosity.clear", icon='X')
         layout.operator("radiosity.export_gltf", icon='EXPORT')
-        if native.error() is not None:
-            box = layout.box()
-            box.alert = True
-            box.label(text="Solver module failed to load; Solve reports why", icon='ERROR')
-
-        draw_stats(layout, settings.stats)
 
 
-def draw_stats(layout, stats):
-    """Draw the last solve's statistics as labels: they are results, not settings."""
-    box = layout.box()
+class RENDER_PT_radiosity_stats(RadiosityPanel, Panel):
+    """What the last solve reported"""
+
+    bl_label = "Statistics"
+    bl_parent_id = "RENDER_PT_radiosity"
+
+    def draw(self, context):
+        draw_stats(self.layout, context, context.scene.radiosity.stats)
+
+
+def draw_stats(layout, context, stats):
+    """The last solve's statistics as labels (results, not settings), named on the left
+    like the settings above them."""
     if not stats.valid:
-        box.label(text="Not solved yet", icon='INFO')
+        layout.label(text="Not solved yet", icon='INFO')
         return
-    col = box.column(align=True)
-    col.label(text="Last solve: %s" % stats.status)
-    col.label(text="Oracle: %s" % stats.oracle)
-    col.label(text="Elements: {:,}   Links: {:,}".format(stats.elements, stats.links))
-    col.label(text="Iterations: %d   Time: %.2f s" % (stats.iterations, stats.seconds))
+    draw_wrapped(layout, context, stats.status)
+    col = layout.column(align=True)
+    for name, value in (("Oracle", stats.oracle),
+                        ("Elements", "{:,}".format(stats.elements)),
+                        ("Links", "{:,}".format(stats.links)),
+                        ("Iterations", "%d" % stats.iterations),
+                        ("Time", "%.2f s" % stats.seconds)):
+        split = col.split(factor=0.4)
+        left = split.row()
+        left.alignment = 'RIGHT'
+        left.label(text=name)
+        split.label(text=value)
     if stats.warning:
-        col.label(text=stats.warning, icon='ERROR')
+        draw_wrapped(layout, context, stats.warning, icon='ERROR')
+
+
+# --- Menus: the Render menu and the 3D view's View menu, where F3 finds them -----------
+
+def draw_operators(layout):
+    layout.operator("radiosity.solve", icon='LIGHT_AREA')
+    layout.operator("radiosity.toggle_result", icon='HIDE_OFF')
+    layout.operator("radiosity.clear", icon='X')
+
+
+class VIEW3D_MT_radiosity(Menu):
+    """Solve the scene's radiosity, show or hide the result, remove it"""
+
+    bl_label = "Radiosity"
+
+    def draw(self, context):
+        draw_operators(self.layout)
+
+
+def draw_render_menu(self, context):
+    self.layout.separator()
+    draw_operators(self.layout)
+
+
+def draw_view_menu(self, context):
+    # Beside Viewport Render: what the 3D view shows of the scene's lighting.
+    self.layout.separator()
+    self.layout.menu("VIEW3D_MT_radiosity")
+
+
+# (menu, draw function) pairs that register() appends and unregister() removes.
+MENU_ENTRIES = (("TOPBAR_MT_render", draw_render_menu), ("VIEW3D_MT_view", draw_view_menu))
+
+
+def register():
+    """After the classes: the menu entries and the fallback progress bar's property."""
+    bpy.types.WindowManager.radiosity_progress = PROGRESS_PROPERTY
+    for menu, function in MENU_ENTRIES:
+        menu = getattr(bpy.types, menu)
+        menu.remove(function)  # never twice, whatever registered before
+        menu.append(function)
+
+
+def unregister():
+    for menu, function in MENU_ENTRIES:
+        getattr(bpy.types, menu).remove(function)
+    del bpy.types.WindowManager.radiosity_progress

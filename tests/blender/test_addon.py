@@ -14,8 +14,8 @@ import addon_utils
 import bpy
 
 import radiosity
-from radiosity import native, operators, pipeline, properties, ui
-from layout_check import CheckedLayout, FakePanel
+from radiosity import bake, native, operators, pipeline, properties, result_state, ui
+from layout_check import DEFAULT_REGION_WIDTH, CheckedLayout, FakeContext, FakePanel, layout_width
 
 # Every type the add-on registers, by its base type and RNA name.
 ADDON_TYPES = (
@@ -26,7 +26,17 @@ ADDON_TYPES = (
     (bpy.types.Operator, "RADIOSITY_OT_clear"),
     (bpy.types.Operator, "RADIOSITY_OT_export_gltf"),
     (bpy.types.Panel, "RENDER_PT_radiosity"),
+    (bpy.types.Panel, "RENDER_PT_radiosity_quality"),
+    (bpy.types.Panel, "RENDER_PT_radiosity_output"),
+    (bpy.types.Panel, "RENDER_PT_radiosity_stats"),
+    (bpy.types.Menu, "VIEW3D_MT_radiosity"),
 )
+PANELS = (ui.RENDER_PT_radiosity, ui.RENDER_PT_radiosity_quality, ui.RENDER_PT_radiosity_output,
+          ui.RENDER_PT_radiosity_stats)
+MENU_OPERATORS = ["radiosity.solve", "radiosity.toggle_result", "radiosity.clear"]
+# What a running solve reports (operators.running_progress).
+PROGRESS = {"fraction": 0.43, "pass": 2, "passes": 7, "leaves": 12316, "elements": 24631,
+            "links": 402113, "seconds": 4.2, "phase": "pass"}
 
 
 def registered_type(base, name):
@@ -55,6 +65,23 @@ def scene_snapshot(scene):
     return data
 
 
+def draw_menu(name):
+    """What the menu bpy.types.`name` draws (the record of a CheckedLayout), with
+    the context of a 3D view (its View menu reads the space's settings)."""
+    layout = CheckedLayout()
+    context = FakeContext()
+    context.space_data = next(s for screen in bpy.data.screens for a in screen.areas
+                              for s in a.spaces if s.type == 'VIEW_3D')
+    getattr(bpy.types, name).draw(FakePanel(layout), context)
+    return layout.record
+
+
+def menu_entries():
+    """How often the Render menu holds Solve, and the View menu the Radiosity menu."""
+    return (draw_menu("TOPBAR_MT_render")["operators"].count("radiosity.solve"),
+            draw_menu("VIEW3D_MT_view")["menus"].count("VIEW3D_MT_radiosity"))
+
+
 def settings_values(group):
     return {p.identifier: getattr(group, p.identifier) for p in group.bl_rna.properties
             if p.identifier != "rna_type" and p.type != 'POINTER'}
@@ -81,6 +108,8 @@ class RegistrationTest(unittest.TestCase):
                 self.assertIsNone(registered_type(base, name), name)
                 self.assertFalse(hasattr(bpy.types, name), name)
             self.assertFalse(any(cls.is_registered for cls in radiosity.classes))
+            self.assertEqual(menu_entries(), (0, 0))
+            self.assertFalse(hasattr(bpy.types.WindowManager, "radiosity_progress"))
         finally:
             radiosity.register()
         # And it comes back whole after a second register.
@@ -97,6 +126,22 @@ class RegistrationTest(unittest.TestCase):
             self.assertFalse(operator_registered())
         finally:
             radiosity.register()
+
+    def test_disable_enable_twice_leaves_one_menu_entry(self):
+        self.assertEqual(menu_entries(), (1, 1))
+        radiosity.unregister()
+        try:
+            for _ in range(2):
+                addon_utils.enable("radiosity", default_set=False, handle_error=self._raise)
+                self.assertEqual(menu_entries(), (1, 1))
+                addon_utils.disable("radiosity", default_set=False, handle_error=self._raise)
+                self.assertEqual(menu_entries(), (0, 0))
+        finally:
+            radiosity.register()
+        self.assertEqual(menu_entries(), (1, 1))
+        # A second register without unregister (a script's) adds no second entry either.
+        ui.register()
+        self.assertEqual(menu_entries(), (1, 1))
 
     @staticmethod
     def _raise(err):
@@ -115,6 +160,15 @@ class RegistrationTest(unittest.TestCase):
         self.assertEqual(manifest["version"], version)
         self.assertEqual(native.version(), version)
         self.assertLessEqual(tuple(radiosity.bl_info["blender"]), bpy.app.version)
+
+    def test_documentation_and_tracker(self):
+        # No project site: the repository's README (a placeholder address) and its issues.
+        repository = "https://github.com/radiosity-for-blender/radiosity"
+        self.assertTrue(radiosity.bl_info["doc_url"].startswith(repository + "#"))
+        self.assertEqual(radiosity.bl_info["tracker_url"], repository + "/issues")
+        manifest_path = os.path.join(os.path.dirname(radiosity.__file__), "blender_manifest.toml")
+        with open(manifest_path, "rb") as f:
+            self.assertEqual(tomllib.load(f)["website"], radiosity.bl_info["doc_url"])
 
 
 class DefaultsTest(unittest.TestCase):
@@ -165,6 +219,20 @@ class DefaultsTest(unittest.TestCase):
                     for item in prop.enum_items:
                         self.assertTrue(item.description, item.identifier)
 
+    def test_iterations_cannot_be_read_as_cycles_bounces(self):
+        # The identifier scripts use stays; the UI name and tooltip say what it is.
+        rna = self.settings.bl_rna.properties["bounces"]
+        self.assertNotIn("Bounce", rna.name)
+        self.assertIn("Not Cycles' light bounces", rna.description)
+        self.assertIn("0 (the default) repeats until the lighting has converged", rna.description)
+
+    def test_tooltips_speak_of_the_picture(self):
+        # The oracles' algorithm names come last, after what they do to the picture.
+        for item in self.settings.bl_rna.properties["oracle"].enum_items:
+            self.assertTrue(item.description.startswith("Adds detail"), item.identifier)
+        standard = self.settings.bl_rna.properties["oracle"].enum_items["STANDARD"].description
+        self.assertLess(standard.index("time"), standard.index("BF refinement"))
+
     def test_limits_are_enforced(self):
         s = self.settings
         s.quality, s.rays, s.max_elements, s.time_budget = 7.0, 0, -5, -1.0
@@ -196,26 +264,69 @@ class DefaultsTest(unittest.TestCase):
 
 
 class PanelTest(unittest.TestCase):
-    def draw(self):
-        layout = CheckedLayout()
-        ui.RENDER_PT_radiosity.draw(FakePanel(layout), bpy.context)
-        return layout.record
+    def draw(self, panel=ui.RENDER_PT_radiosity, width=DEFAULT_REGION_WIDTH, layout=None):
+        """Draw `panel` as in a Properties region `width` wide; return its layout."""
+        layout = layout or CheckedLayout()
+        panel.draw(FakePanel(layout), FakeContext(width))
+        return layout
+
+    def assert_fits(self, layout, width=DEFAULT_REGION_WIDTH):
+        self.assertEqual(layout.overflows(layout_width(width)), [],
+                         "(text, its width, room) cut at a region %d px wide" % width)
+
+    def running(self, progress=PROGRESS):
+        """A context in which operators.running_progress reports `progress`."""
+        test = self
+
+        class Running:
+            def __enter__(self):
+                self.saved = operators.running_progress
+                operators.running_progress = lambda: None if progress is None else dict(progress)
+
+            def __exit__(self, *exc):
+                operators.running_progress = self.saved
+                return False
+
+        test.assertIsNone(operators.running_progress())  # no solve runs in these tests
+        return Running()
 
     def test_poll(self):
         self.assertTrue(ui.RENDER_PT_radiosity.poll(bpy.context))
-        panel = bpy.types.RENDER_PT_radiosity
-        self.assertEqual((panel.bl_space_type, panel.bl_region_type, panel.bl_context),
-                         ('PROPERTIES', 'WINDOW', "render"))
+        for panel in PANELS:
+            registered = getattr(bpy.types, panel.__name__)
+            self.assertEqual((registered.bl_space_type, registered.bl_region_type, registered.bl_context),
+                             ('PROPERTIES', 'WINDOW', "render"))
 
-    def test_draws_every_setting_and_the_solve_button(self):
-        record = self.draw()
-        drawn = {name for data, name in record["props"] if isinstance(data, properties.RadiositySettings)}
+    def test_sub_panels(self):
+        self.assertEqual(getattr(bpy.types.RENDER_PT_radiosity, "bl_parent_id", ""), "")
+        children = {panel.bl_label: panel for panel in PANELS[1:]}
+        self.assertEqual(list(children), ["Quality and Limits", "Output", "Statistics"])
+        for panel in children.values():
+            self.assertEqual(getattr(bpy.types, panel.__name__).bl_parent_id, "RENDER_PT_radiosity")
+            # All open at first: the settings and the statistics are what the panel is for.
+            self.assertNotIn('DEFAULT_CLOSED', getattr(panel, "bl_options", set()))
+
+    def test_solve_button_first(self):
+        layout = self.draw()
+        self.assertEqual(layout.record["operators"], MENU_OPERATORS)
+        # The parent's first row is the large Solve button.
+        kind, column = layout._items[0]
+        kind, row = column._items[0]
+        self.assertEqual(row._items[0][1:3], ("button", "Solve Radiosity"))
+        self.assertEqual(row.scale_y, 1.5)
+
+    def test_draws_every_setting_once(self):
+        drawn = []
+        operators_drawn = []
+        for panel in PANELS:
+            record = self.draw(panel).record
+            drawn += [name for data, name in record["props"] if isinstance(data, properties.RadiositySettings)]
+            operators_drawn += record["operators"]
         # The add-on's own settings; `stats` is drawn as labels.
         settings = set(properties.RadiositySettings.__annotations__) - {"stats"}
-        self.assertEqual(drawn, settings)
-        self.assertEqual(record["operators"], ["radiosity.solve", "radiosity.toggle_result", "radiosity.clear",
-                                               "radiosity.export_gltf"])
-        self.assertIn("Not solved yet", record["labels"])
+        self.assertEqual(sorted(drawn), sorted(settings))
+        self.assertEqual(operators_drawn, MENU_OPERATORS + ["radiosity.export_gltf"])
+        self.assertIn("Not solved yet", self.draw(ui.RENDER_PT_radiosity_stats).record["labels"])
 
     def test_draws_last_solve_statistics(self):
         stats = bpy.context.scene.radiosity.stats
@@ -223,13 +334,126 @@ class PanelTest(unittest.TestCase):
         stats.elements, stats.links, stats.iterations, stats.seconds = 12345, 67890, 4, 1.5
         stats.warning = "2 point lights not modelled"
         try:
-            labels = self.draw()["labels"]
+            labels = self.draw(ui.RENDER_PT_radiosity_stats, width=600).record["labels"]
         finally:
             stats.clear()
-        self.assertIn("Last solve: Converged", labels)
-        self.assertIn("Elements: 12,345   Links: 67,890", labels)
-        self.assertIn("Iterations: 4   Time: 1.50 s", labels)
-        self.assertIn("2 point lights not modelled", labels)
+        self.assertEqual(labels, ["Converged", "Oracle", "Perceptual", "Elements", "12,345", "Links", "67,890",
+                                  "Iterations", "4", "Time", "1.50 s", "2 point lights not modelled"])
+
+    def test_labels_fit_the_default_width(self):
+        for panel in PANELS:
+            with self.subTest(panel=panel.bl_label):
+                self.assert_fits(self.draw(panel))
+
+    def test_long_texts_are_wrapped_to_fit(self):
+        stats = bpy.context.scene.radiosity.stats
+        stats.valid, stats.status, stats.oracle = True, pipeline.STATUS["cancel"], "Gradient"
+        stats.elements, stats.links, stats.iterations, stats.seconds = 1234567, 98765432, 40, 1234.5
+        stats.warning = ("Not modelled: 2 point lights, 1 spot light (only area lights and emissive "
+                         "surfaces are); faces left out: 3 degenerate faces of Chair.001")
+        saved = native.advice
+        native.advice = lambda: native.what_to_do(False)
+        try:
+            for width in (DEFAULT_REGION_WIDTH, 248, 400):
+                for panel in (ui.RENDER_PT_radiosity, ui.RENDER_PT_radiosity_stats):
+                    with self.subTest(panel=panel.bl_label, width=width):
+                        layout = self.draw(panel, width)
+                        self.assert_fits(layout, width)
+            labels = self.draw(ui.RENDER_PT_radiosity_stats).record["labels"]
+        finally:
+            native.advice = saved
+            stats.clear()
+        self.assertEqual(" ".join(labels[:2]), pipeline.STATUS["cancel"])
+
+    def test_the_checker_sees_what_was_cut(self):
+        # The texts the issue found cut at the default width are cut by the checker's
+        # measure too, and their replacements are not.
+        settings = bpy.context.scene.radiosity
+        layout = CheckedLayout()
+        layout.use_property_split = True
+        layout.prop(settings, "min_element_size", text="Smallest Element")
+        layout.prop(settings, "min_element_size")
+        row = layout.row(align=True)
+        row.operator("radiosity.toggle_result", icon='HIDE_OFF')
+        row.operator("radiosity.clear", icon='X')
+        cut = [text for text, need, room in layout.overflows()]
+        self.assertEqual(cut, ["Smallest Element", "Toggle Radiosity Result", "Remove Radiosity Result"])
+
+    def test_progress_bar_while_solving(self):
+        # Blender 4.0+ draws UILayout.progress; 3.4 has none, and CheckedLayout then has
+        # none either (it knows only the running Blender's UILayout).
+        with self.running():
+            layout = self.draw(width=600)
+        if "progress" in bpy.types.UILayout.bl_rna.functions:
+            self.assertIn("Pass 3 of 7 · 12,316 elements · 4.2 s", layout.record["labels"])
+            self.assertNotIn("12,316 elements", layout.record["labels"])
+            self.assertNotIn((bpy.context.window_manager, "radiosity_progress"), layout.record["props"])
+        else:
+            self.assertIn((bpy.context.window_manager, "radiosity_progress"), layout.record["props"])
+        self.assertIn("Esc to cancel", layout.record["labels"])
+        self.assertEqual(layout.record["operators"][0], "radiosity.solve")
+
+    def test_fallback_bar_while_solving(self):
+        class WithoutProgress(CheckedLayout):
+            # A layout of a Blender before 4.0, also in 4.x.
+            def __getattr__(self, name):
+                if name == "progress":
+                    raise AttributeError(name)
+                return super().__getattr__(name)
+
+        wm = bpy.context.window_manager
+        with self.running():
+            layout = self.draw(layout=WithoutProgress())
+            value = wm.radiosity_progress
+        self.assert_fits(layout)
+        self.assertIn((wm, "radiosity_progress"), layout.record["props"])
+        self.assertIn("12,316 elements", layout.record["labels"])
+        self.assertAlmostEqual(value, 43.0, places=4)
+        self.assertEqual(wm.radiosity_progress, 0.0)  # nothing runs now
+        # The slider shows the text; dragging it changes nothing.
+        wm.radiosity_progress = 90.0
+        self.assertEqual(wm.radiosity_progress, 0.0)
+
+    def test_progress_fits_the_default_width(self):
+        for progress in (PROGRESS, {}, dict(PROGRESS, phase="linking", passes=0, fraction=0.02),
+                         dict(PROGRESS, leaves=98765432, seconds=12345.6, passes=17, **{"pass": 16})):
+            with self.subTest(progress=progress), self.running(progress):
+                layout = self.draw()
+                self.assert_fits(layout)
+                labels = layout.record["labels"]
+            if progress is PROGRESS:
+                # Too long for one line here: the count goes below the bar.
+                self.assertIn("12,316 elements", labels)
+        self.assertEqual(ui.progress_texts({}), ("Starting", "Starting", ""))
+        self.assertEqual(ui.progress_texts(PROGRESS), ("Pass 3 of 7 · 12,316 elements · 4.2 s",
+                                                       "Pass 3 of 7 · 4.2 s", "12,316 elements"))
+        self.assertEqual(ui.progress_texts(dict(PROGRESS, phase="linking", passes=0, leaves=0))[:2],
+                         ("Preparing · 4.2 s", "Preparing · 4.2 s"))
+        self.assertEqual(ui.progress_texts(dict(PROGRESS, seconds=3725.2))[1], "Pass 3 of 7 · 1:02:05")
+        # `pass` counts from 0; after the last pass (phase done) it is the pass count.
+        self.assertEqual(ui.progress_texts(dict(PROGRESS, phase="refining", **{"pass": 0}))[1], "Pass 1 of 7 · 4.2 s")
+        self.assertEqual(ui.progress_texts(dict(PROGRESS, phase="done", **{"pass": 7}))[1], "Pass 7 of 7 · 4.2 s")
+
+    def test_warns_when_a_result_object_is_selected(self):
+        mesh = bpy.data.meshes.new("result mesh")
+        obj = bpy.data.objects.new("result", mesh)
+        bpy.context.scene.collection.objects.link(obj)
+        layer = bpy.context.view_layer
+        active = layer.objects.active
+        try:
+            self.assertNotIn(ui.EDIT_WARNING, self.draw(width=600).record["labels"])
+            obj[result_state.RESULT_TAG] = "Cube"
+            self.assertNotIn(ui.EDIT_WARNING, self.draw(width=600).record["labels"])
+            layer.objects.active = obj
+            self.assertIn(ui.EDIT_WARNING, self.draw(width=600).record["labels"])
+            layer.objects.active = active
+            obj.select_set(True)
+            self.assertIn(ui.EDIT_WARNING, self.draw(width=600).record["labels"])
+            self.assert_fits(self.draw())
+        finally:
+            layer.objects.active = active
+            bpy.data.objects.remove(obj)
+            bpy.data.meshes.remove(mesh)
 
     def test_layout_check_is_strict(self):
         # The checker itself must catch what real drawing reports as errors.
@@ -245,6 +469,89 @@ class PanelTest(unittest.TestCase):
             layout.label(text="x", icon='NO_SUCH_ICON')
         with self.assertRaises(AttributeError):
             layout.use_property_splitt = True
+
+
+class MenuTest(unittest.TestCase):
+    """Solve, Toggle and Remove in the Render menu and the 3D view's View > Radiosity,
+    where F3 menu search finds them."""
+
+    def test_render_menu(self):
+        operators_drawn = draw_menu("TOPBAR_MT_render")["operators"]
+        self.assertEqual([o for o in operators_drawn if o.startswith("radiosity.")], MENU_OPERATORS)
+        self.assertEqual(operators_drawn[-3:], MENU_OPERATORS)  # after Blender's own
+
+    def test_view_menu(self):
+        record = draw_menu("VIEW3D_MT_view")
+        self.assertEqual(record["menus"].count("VIEW3D_MT_radiosity"), 1)
+        self.assertEqual(draw_menu("VIEW3D_MT_radiosity")["operators"], MENU_OPERATORS)
+        self.assertEqual(bpy.types.VIEW3D_MT_radiosity.bl_label, "Radiosity")
+
+    def test_operator_names_are_descriptive(self):
+        # What F3 lists: the panel's buttons say less ("Toggle Result").
+        names = [getattr(bpy.ops.radiosity, o.partition(".")[2]).get_rna_type().name for o in MENU_OPERATORS]
+        self.assertEqual(names, ["Solve Radiosity", "Toggle Radiosity Result", "Remove Radiosity Result"])
+
+
+class NativeMessageTest(unittest.TestCase):
+    """What a user is told when the solver module does not load."""
+
+    def test_source_build(self):
+        package = os.path.dirname(radiosity.__file__)
+        self.assertTrue(native.source_build(package))  # the tests run from BUILD/addon/radiosity
+        with tempfile.TemporaryDirectory() as tmp:
+            self.assertFalse(native.source_build(os.path.join(tmp, "addons", "radiosity")))
+        advice = native.what_to_do(True)
+        self.assertIn("rebuild the add-on with `make`", advice)
+
+    def test_installed_zip(self):
+        advice = native.what_to_do(False)
+        self.assertNotIn("make", advice)
+        version = ".".join(map(str, radiosity.bl_info["version"]))
+        self.assertIn("radiosity-%s-linux_x64.zip (the extension) for Blender 4.2 and later" % version, advice)
+        self.assertIn("radiosity-%s-legacy_linux_x64.zip for Blender 3.4 to 4.1" % version, advice)
+        self.assertIn("built for Linux x64 and Python 3.", advice)
+
+    def test_panel_shows_what_to_do(self):
+        saved = native.advice
+        native.advice = lambda: native.what_to_do(False)
+        try:
+            labels = PanelTest.draw(None, width=4000).record["labels"]
+        finally:
+            native.advice = saved
+        self.assertIn("Solver failed to load", labels)
+        self.assertIn(native.what_to_do(False), labels)
+
+
+class ResultObjectTest(unittest.TestCase):
+    """The result objects are generated: not selectable, and marked so."""
+
+    @classmethod
+    def setUpClass(cls):
+        # Solved in a scene file of its own; the factory scene the other tests use
+        # is saved first and opened again after.
+        from test_solve import open_scene  # here: test_solve imports this file
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.factory = os.path.join(cls.tmp.name, "factory.blend")
+        bpy.ops.wm.save_as_mainfile(filepath=cls.factory, copy=True)
+        scene = open_scene("cube")
+        scene.radiosity.quality = 0.2
+        cls.solved = bpy.ops.radiosity.solve()
+        cls.results = [(o.name, o.hide_select, o.get(bake.GENERATED_NOTE_TAG))
+                       for o in result_state.result_objects(scene)]
+        cls.originals = [o.hide_select for o in scene.objects if not o.get(result_state.RESULT_TAG)]
+
+    @classmethod
+    def tearDownClass(cls):
+        bpy.ops.wm.open_mainfile(filepath=cls.factory)
+        cls.tmp.cleanup()
+
+    def test_not_selectable_and_marked(self):
+        self.assertEqual(self.solved, {'FINISHED'})
+        self.assertGreater(len(self.results), 0)
+        for name, hide_select, note in self.results:
+            self.assertTrue(hide_select, name)
+            self.assertIn("edits are replaced by the next Solve", note)
+        self.assertFalse(any(self.originals))  # the user's objects are left as they were
 
 
 class UnlitFactoryScene:
