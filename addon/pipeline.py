@@ -199,7 +199,7 @@ def bake_result(context, job, result, replace_previous):
     skipped_objects = []
     warnings = []
     convert = material = None
-    # Lighting Only keeps the user's materials, which no unlit material can
+    # Lit Materials keeps the user's materials, which no unlit material can
     # stand in for: game-ready colours apply to the other outputs.
     if settings.display_colours and mode != 'LIGHTING':
         convert, material, note = game_export.bake_options(scene)

@@ -257,7 +257,8 @@ class RadiositySettings(PropertyGroup):
         name="View Result",
         description=(
             "Show the result in Solid shading as it will render: colour attribute, flat "
-            "lighting. Your shading settings come back when you toggle or remove the result"
+            "lighting, back faces hidden. Your shading settings come back when you toggle "
+            "or remove the result"
         ),
         default=True,
     )

@@ -238,6 +238,7 @@ class RENDER_PT_radiosity_output(RadiosityPanel, Panel):
         col = layout.column()
         col.prop(settings, "output")
         col.prop(settings, "show_wireframe")
+        col.prop(settings, "view_result")
 
         col = layout.column(heading="Colours")
         col.active = settings.output != 'LIGHTING'  # it keeps the materials: nothing to make unlit
