@@ -8,7 +8,7 @@ packages=(
   python3 python3-dev python3-venv python3-numpy python3-matplotlib
   pybind11-dev libglm-dev libopenimageio-dev libembree-dev libtbb-dev
   libgtest-dev libbenchmark-dev
-  xvfb libgl1-mesa-dri  # the interactive (modal, ESC) test runs Blender in a virtual display
+  xvfb libgl1-mesa-dri xdotool  # the interactive (modal, Esc) tests: Blender in a virtual display, real key presses
   clang-format-16       # tests/native/test_format.py: the C++ follows .clang-format
 )
 

@@ -22,7 +22,7 @@ import traceback
 import bpy
 from bpy.types import Operator
 
-from . import bake, native, pipeline, result_state
+from . import bake, live_pacing, native, pipeline, result_state
 
 # The interactive solve in progress (at most one: the operator is modal), so
 # that scripts and the UI can follow it.
@@ -96,6 +96,7 @@ class RADIOSITY_OT_solve(Operator):
         self._job = _running_job = job
         job.monitor = solver.ProgressMonitor(pass_results=True)
         self._live = None  # the passes shown so far (pipeline.LiveResult)
+        self._pacing = live_pacing.LivePacing()
         self._status, self._status_time = "", 0.0  # the status text shown, and when
         self._token = solver.CancelToken()
         self._thread = threading.Thread(target=pipeline.work, args=(solver, job, self._token),
@@ -151,13 +152,17 @@ class RADIOSITY_OT_solve(Operator):
                 self._status, self._status_time = text, now
                 context.window_manager.progress_update(100.0 * float(progress.get("fraction", 0.0)))
                 context.workspace.status_text_set(text + "  (Esc to cancel)")
+        if not self._pacing.may_show():
+            return  # the newest pass waits in the monitor (a newer one replaces it)
         result = job.monitor.take_pass_result()
         if result is None:
             return
         try:
+            began = time.perf_counter()
             if self._live is None:
                 self._live = pipeline.LiveResult(context)
             self._live.show(context, job, result)
+            self._pacing.shown(began, time.perf_counter())
         except Exception:
             # The scene is back as it was (LiveResult.abort); the solve goes on
             # and its final bake reports what fails.
@@ -171,6 +176,7 @@ class RADIOSITY_OT_solve(Operator):
     def _stop_modal(self, context):
         global _running_job
         _running_job = None
+        self._pacing.close()
         wm = context.window_manager
         if self._timer is not None:
             wm.event_timer_remove(self._timer)
