@@ -23,6 +23,7 @@ import bpy
 from bpy.types import Operator
 
 from . import bake, live_pacing, native, pipeline, result_state
+from .progress_text import status_line
 
 # The interactive solve in progress (at most one: the operator is modal), so
 # that scripts and the UI can follow it.
@@ -37,16 +38,6 @@ def running_progress():
     return None if job is None else dict(job.progress)
 
 
-def progress_text(progress):
-    """One line describing a progress dict of the solver."""
-    if not progress:
-        return "Radiosity: starting"
-    return "Radiosity: {:.0%}, pass {} of {}, {}, {:,} elements, {:,} links, {:.0f} s".format(
-        progress.get("fraction", 0.0), progress.get("pass", 0) + 1, progress.get("passes", 0),
-        progress.get("phase", ""), progress.get("leaves", progress.get("elements", 0)),
-        progress.get("links", 0), progress.get("seconds", 0.0))
-
-
 def pass_printer():
     """A progress callback that prints one line per pass."""
     last = [None]
@@ -54,7 +45,7 @@ def pass_printer():
     def progress(p):
         if p.get("pass") != last[0]:
             last[0] = p.get("pass")
-            print(progress_text(p), flush=True)
+            print(status_line(p), flush=True)
     return progress
 
 
@@ -105,7 +96,7 @@ class RADIOSITY_OT_solve(Operator):
         self._timer = wm.event_timer_add(0.1, window=context.window)
         wm.progress_begin(0, 100)
         wm.modal_handler_add(self)
-        context.workspace.status_text_set(progress_text({}) + "  (Esc to cancel)")
+        context.workspace.status_text_set(status_line({}) + "  (Esc to cancel)")
         self._thread.start()
         return {'RUNNING_MODAL'}
 
@@ -142,36 +133,41 @@ class RADIOSITY_OT_solve(Operator):
         progress = job.monitor.progress()
         if progress is not None:
             job.progress = progress
-            # Each status or cursor change redraws part of the window, which costs
-            # as much CPU as the solve with software OpenGL (measured under Xvfb:
-            # full_office took 18 s with an update every tick, 9 s without): only
-            # what a user would notice, at most once a second.
-            now = time.perf_counter()
-            text = progress_text(progress)
-            if not self._token.cancelled and text != self._status and now - self._status_time >= 1.0:
-                self._status, self._status_time = text, now
-                context.window_manager.progress_update(100.0 * float(progress.get("fraction", 0.0)))
-                context.workspace.status_text_set(text + "  (Esc to cancel)")
-        if not self._pacing.may_show():
-            return  # the newest pass waits in the monitor (a newer one replaces it)
-        result = job.monitor.take_pass_result()
-        if result is None:
+        # A newer pass replaces one waiting in the monitor while the pacing says wait.
+        result = job.monitor.take_pass_result() if self._pacing.may_show() else None
+        if result is not None:
+            try:
+                began = time.perf_counter()
+                if self._live is None:
+                    self._live = pipeline.LiveResult(context)
+                self._live.show(context, job, result)
+                self._pacing.shown(began, time.perf_counter())
+            except Exception:
+                # The scene is back as it was (LiveResult.abort); the solve goes on
+                # and its final bake reports what fails.
+                traceback.print_exc(file=sys.stderr)
+                self._live = None
+            # Redraw the panels too: the statistics and the progress bar live there.
+            for area in context.screen.areas if context.screen else ():
+                if area.type in {'VIEW_3D', 'PROPERTIES'}:
+                    area.tag_redraw()
+        self._show_status(context, progress, with_pass=result is not None)
+
+    def _show_status(self, context, progress, with_pass):
+        """The status text and cursor: at most once a second, or with a pass shown.
+
+        Each change redraws part of the window, which costs as much CPU as the
+        solve with software OpenGL (measured under Xvfb: full_office took 18 s
+        with an update every tick, 9 s without); with a pass it comes with the
+        redraw the pass needs anyway."""
+        if progress is None or self._token.cancelled:
             return
-        try:
-            began = time.perf_counter()
-            if self._live is None:
-                self._live = pipeline.LiveResult(context)
-            self._live.show(context, job, result)
-            self._pacing.shown(began, time.perf_counter())
-        except Exception:
-            # The scene is back as it was (LiveResult.abort); the solve goes on
-            # and its final bake reports what fails.
-            traceback.print_exc(file=sys.stderr)
-            self._live = None
-        # Redraw the panels too: the statistics and the progress bar live there.
-        for area in context.screen.areas if context.screen else ():
-            if area.type in {'VIEW_3D', 'PROPERTIES'}:
-                area.tag_redraw()
+        now = time.perf_counter()
+        text = status_line(progress)
+        if text != self._status and (with_pass or now - self._status_time >= 1.0):
+            self._status, self._status_time = text, now
+            context.window_manager.progress_update(100.0 * float(progress.get("fraction", 0.0)))
+            context.workspace.status_text_set(text + "  (Esc to cancel)")
 
     def _stop_modal(self, context):
         global _running_job

@@ -1,7 +1,7 @@
 """Blender side of test_interactive.py: the interactive solve in a real window.
 
     xvfb-run blender --factory-startup FILE.blend \
-        --python interactive_solve.py -- ADDON_DIR run|cancel|cancel_after:SECONDS
+        --python interactive_solve.py -- ADDON_DIR run|cancel|cancel_after:SECONDS [SHOTS_DIR]
 
 Once the window is idle (its first draws compile shaders, seconds of CPU under
 software OpenGL), invokes radiosity.solve with INVOKE_DEFAULT in the 3D view
@@ -10,7 +10,9 @@ display with xdotool (after the first pass, or SECONDS after the click), waits
 for the bake and prints one line "RESULT <json>" before quitting. While the
 solve runs a timer watches it as a user would: the progress it reports, how
 often a UI timer gets to run, the result meshes changing pass by pass, and
-the elements refined 2, 4 and 6 s after the click.
+the elements refined 2, 4 and 6 s after the click. With SHOTS_DIR it writes
+SHOTS_DIR/solve_in_progress.png, the window when the first pass is shown
+(the Properties editor scrolled to the Radiosity panel).
 
 Not --enable-event-simulate: with it Blender polls for events without ever
 sleeping, and that busy main thread took a core from the solve. The
@@ -28,7 +30,9 @@ import time
 import addon_utils
 import bpy
 
-ADDON, MODE = sys.argv[sys.argv.index("--") + 1:][:2]
+ARGS = sys.argv[sys.argv.index("--") + 1:]
+ADDON, MODE = ARGS[:2]
+SHOTS = ARGS[2] if len(ARGS) > 2 else None
 sys.path.insert(0, ADDON)
 
 
@@ -47,6 +51,34 @@ MARKS = (2.0, 4.0, 6.0)  # seconds after the click at which the refined elements
 
 def window():
     return bpy.context.window_manager.windows[0]
+
+
+def properties_area():
+    return next(a for a in window().screen.areas if a.type == 'PROPERTIES')
+
+
+def show_render_tab():
+    properties_area().spaces.active.context = 'RENDER'
+
+
+def show_the_panel():
+    """The Properties editor (on the Render tab since it last drew) scrolled to
+    the Radiosity panel, at its end."""
+    win, area = window(), properties_area()
+    region = next(r for r in area.regions if r.type == 'WINDOW')
+    with bpy.context.temp_override(window=win, screen=win.screen, area=area, region=region):
+        for _ in range(100):
+            bpy.ops.view2d.scroll_down()
+        for _ in range(5):  # back up to the Solve button and its progress bar
+            bpy.ops.view2d.scroll_up()
+
+
+def screenshot_in_progress():
+    import os
+    win = window()
+    with bpy.context.temp_override(window=win, screen=win.screen, area=win.screen.areas[0]):
+        bpy.ops.screen.screenshot(filepath=os.path.join(SHOTS, "solve_in_progress.png"))
+    state["screenshot_at"] = time.time() - state["start"]
 
 
 def start():
@@ -90,6 +122,8 @@ def watch():
         if polygons and (not state["mesh_states"] or state["mesh_states"][-1] != polygons):
             state["mesh_states"].append(polygons)
             state["updates_while_running"] += 1
+            if SHOTS and "screenshot_at" not in state:
+                screenshot_in_progress()
     return 0.05
 
 
@@ -137,6 +171,7 @@ def check():
         "running_seconds": state["running_seconds"], "updates_while_running": state["updates_while_running"],
         "final_polygons": result_polygons(), "escaped_at": state.get("escaped_at"),
         "leaves_after": state["leaves_after"], "idle_after": state.get("idle_after"),
+        "screenshot_at": state.get("screenshot_at"),
     }), flush=True)
     bpy.ops.wm.quit_blender()
     return None
@@ -152,11 +187,15 @@ def start_when_idle():
     if last is None or (cpu - last[1] > 0.1 * (now - last[0]) and waited < 30.0):
         return 0.25
     state["idle_after"] = waited
+    if SHOTS:
+        show_the_panel()
     start()
     return None
 
 
 state["launched"] = time.perf_counter()
+if SHOTS:
+    bpy.app.timers.register(show_render_tab, first_interval=0.1)
 bpy.app.timers.register(start_when_idle, first_interval=0.5)
 bpy.app.timers.register(watch, first_interval=0.55)
 if MODE == "cancel":

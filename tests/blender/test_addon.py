@@ -14,7 +14,7 @@ import addon_utils
 import bpy
 
 import radiosity
-from radiosity import bake, native, operators, pipeline, properties, result_state, ui
+from radiosity import bake, native, operators, pipeline, progress_text, properties, result_state, ui
 from layout_check import DEFAULT_REGION_WIDTH, CheckedLayout, FakeContext, FakePanel, layout_width
 
 # Every type the add-on registers, by its base type and RNA name.
@@ -424,15 +424,18 @@ class PanelTest(unittest.TestCase):
             if progress is PROGRESS:
                 # Too long for one line here: the count goes below the bar.
                 self.assertIn("12,316 elements", labels)
-        self.assertEqual(ui.progress_texts({}), ("Starting", "Starting", ""))
-        self.assertEqual(ui.progress_texts(PROGRESS), ("Pass 3 of 7 · 12,316 elements · 4.2 s",
+        self.assertEqual(progress_text.progress_texts({}), ("Starting", "Starting", ""))
+        self.assertEqual(progress_text.progress_texts(PROGRESS), ("Pass 3 of 7 · 12,316 elements · 4.2 s",
                                                        "Pass 3 of 7 · 4.2 s", "12,316 elements"))
-        self.assertEqual(ui.progress_texts(dict(PROGRESS, phase="linking", passes=0, leaves=0))[:2],
+        self.assertEqual(progress_text.progress_texts(dict(PROGRESS, phase="linking", passes=0, leaves=0))[:2],
                          ("Preparing · 4.2 s", "Preparing · 4.2 s"))
-        self.assertEqual(ui.progress_texts(dict(PROGRESS, seconds=3725.2))[1], "Pass 3 of 7 · 1:02:05")
+        self.assertEqual(progress_text.progress_texts(dict(PROGRESS, seconds=3725.2))[1], "Pass 3 of 7 · 1:02:05")
         # `pass` counts from 0; after the last pass (phase done) it is the pass count.
-        self.assertEqual(ui.progress_texts(dict(PROGRESS, phase="refining", **{"pass": 0}))[1], "Pass 1 of 7 · 4.2 s")
-        self.assertEqual(ui.progress_texts(dict(PROGRESS, phase="done", **{"pass": 7}))[1], "Pass 7 of 7 · 4.2 s")
+        self.assertEqual(progress_text.progress_texts(dict(PROGRESS, phase="refining", **{"pass": 0}))[1], "Pass 1 of 7 · 4.2 s")
+        self.assertEqual(progress_text.progress_texts(dict(PROGRESS, phase="done", **{"pass": 7}))[1], "Pass 7 of 7 · 4.2 s")
+        # The status bar's line says the same, after the fraction.
+        self.assertEqual(progress_text.status_line(PROGRESS),
+                         "Radiosity: 43% · Pass 3 of 7 · 12,316 elements · 4.2 s")
 
     def test_warns_when_a_result_object_is_selected(self):
         mesh = bpy.data.meshes.new("result mesh")

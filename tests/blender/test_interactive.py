@@ -24,6 +24,8 @@ from radiosity import native, pipeline
 from test_solve import ADDON_DIR, build_file, open_scene
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+SHOTS = os.path.join(os.path.dirname(ADDON_DIR), "screenshots")  # <build>/screenshots
+os.makedirs(SHOTS, exist_ok=True)
 
 
 def headless_timeline(name, quality, marks, passes_after):
@@ -60,10 +62,10 @@ def headless_timeline(name, quality, marks, passes_after):
 @unittest.skipIf(shutil.which("xdotool") is None, "xdotool not installed (apt-get install xdotool)")
 @unittest.skipIf("blender_cli" in sys.modules, "bpy (Blender as a Python module) has no windows")
 class InteractiveSolveTest(unittest.TestCase):
-    def run_window(self, scene, mode):
+    def run_window(self, scene, mode, shots=None):
         cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x800x24", bpy.app.binary_path, "--factory-startup",
                build_file(scene), "--python",
-               os.path.join(HERE, "interactive_solve.py"), "--", ADDON_DIR, mode]
+               os.path.join(HERE, "interactive_solve.py"), "--", ADDON_DIR, mode] + ([shots] if shots else [])
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=300, stdin=subprocess.DEVNULL)
         lines = [l for l in proc.stdout.splitlines() if l.startswith("RESULT ")]
         self.assertTrue(lines, proc.stdout[-3000:] + proc.stderr[-3000:])
@@ -82,9 +84,13 @@ class InteractiveSolveTest(unittest.TestCase):
         # A solve of a furnished room takes seconds: its passes reach the
         # viewport while it runs, the progress only moves forward, and a UI
         # timer keeps running.
-        r = self.run_window("full_office", "run")
+        shot = os.path.join(SHOTS, "solve_in_progress.png")
+        if os.path.exists(shot):
+            os.remove(shot)
+        r = self.run_window("full_office", "run", SHOTS)
         self.assertTrue(r["valid"], r)
         self.assertGreaterEqual(r["updates_while_running"], 1, r)
+        self.assertTrue(os.path.exists(shot), r)  # the window as a pass was shown
         fractions = r["fractions"]
         self.assertGreater(len(fractions), 3, r)
         self.assertEqual(fractions, sorted(fractions), "the progress went back")
@@ -105,11 +111,9 @@ class InteractiveSolveTest(unittest.TestCase):
         import matplotlib.image as mpimg
         import numpy as np
         from numpy.lib.stride_tricks import sliding_window_view
-        shots = os.path.join(os.path.dirname(ADDON_DIR), "screenshots")
-        os.makedirs(shots, exist_ok=True)
         speckle = {}
         for mode in ("cull", "nocull"):
-            out = os.path.join(shots, "full_office_solid_%s.png" % mode)
+            out = os.path.join(SHOTS, "full_office_solid_%s.png" % mode)
             if os.path.exists(out):
                 os.remove(out)
             cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x800x24", bpy.app.binary_path, "--factory-startup",
