@@ -34,6 +34,12 @@ struct CancelToken {
 // it (Blender's UI timer). The solver thread only copies under a mutex and
 // never waits for Python's GIL, so a busy interface cannot slow the solve (a
 // callback waits for the GIL at every report) and the solve cannot stall it.
+// A SolveReuse and the lock that keeps two solves from using it at once.
+struct PyReuse {
+  SolveReuse reuse;
+  std::mutex mutex;
+};
+
 struct ProgressMonitor {
   std::mutex mutex;
   std::optional<SolveProgress> latest;     // its pass_result cleared
@@ -207,6 +213,8 @@ py::dict stats_dict(const SolveStats& s) {
   d["skipped_faces"] = s.skipped_faces;
   d["repaired_faces"] = s.repaired_faces;
   d["cancelled"] = s.cancelled;
+  d["reused"] = s.reused;
+  d["reuse_refusal"] = s.reuse_refusal;
   d["stopped_by"] = std::string(stop_reason_name(s.stopped_by));
   d["seconds"] = s.seconds;
   d["seconds_linking"] = s.seconds_linking;
@@ -307,7 +315,7 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
                   const py::object& threads, const py::object& progress, const py::object& cancel,
                   double min_element_area, const std::string& leaf_links,
                   std::optional<double> cluster_separation, const py::object& memory_limit,
-                  bool pass_results, bool yield_to_interface) {
+                  bool pass_results, bool yield_to_interface, const py::object& reuse) {
   SolveOptions options;
   options.oracle = read_oracle(oracle);
   options.quality = quality;
@@ -341,6 +349,12 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
                                 "'");
   options.leaf_links = *links;
 
+  PyReuse* kept = nullptr;
+  if (!reuse.is_none()) {
+    if (!py::isinstance<PyReuse>(reuse))
+      throw std::invalid_argument("reuse must be a SolveReuse or None");
+    kept = reuse.cast<PyReuse*>();
+  }
   const CancelToken* token = nullptr;
   if (!cancel.is_none()) {
     if (!py::isinstance<CancelToken>(cancel))
@@ -377,8 +391,15 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
   };
   SolveResult result;
   {
+    // Taken before the GIL goes: a second solve with the same reuse fails at once.
+    std::unique_lock<std::mutex> in_use;
+    if (kept) {
+      in_use = std::unique_lock<std::mutex>(kept->mutex, std::try_to_lock);
+      if (!in_use.owns_lock())
+        throw std::invalid_argument("this SolveReuse is in use by another solve");
+    }
     py::gil_scoped_release release;
-    result = solve(scene, options, callback, cancelled);
+    result = solve(scene, options, callback, cancelled, kept ? &kept->reuse : nullptr);
   }
   if (callback_error) std::rethrow_exception(callback_error);
   return to_python(std::move(result));
@@ -400,6 +421,28 @@ void bind_solver(py::module_& m) {
       .def(
           "cancel", [](CancelToken& t) { t.flag = true; }, "Ask the solve to stop.")
       .def_property_readonly("cancelled", [](const CancelToken& t) { return t.flag.load(); });
+
+  py::class_<PyReuse>(
+      m, "SolveReuse",
+      "Keeps the elements and links of the last complete solve it was passed to\n"
+      "(solve(reuse=...)), so that the next solve of the same geometry with the same options\n"
+      "relights it (stats['reused']) when only emission, reflectance or the lights' colours\n"
+      "and strengths changed; otherwise that solve starts from nothing and is kept instead.")
+      .def(py::init<>())
+      .def_property_readonly(
+          "holds", [](PyReuse& r) { return r.reuse.holds(); }, "whether a solve is kept")
+      .def_property_readonly(
+          "memory_bytes", [](PyReuse& r) { return r.reuse.memory_bytes(); },
+          "bytes the kept solve holds")
+      .def(
+          "clear",
+          [](PyReuse& r) {
+            std::unique_lock<std::mutex> in_use(r.mutex, std::try_to_lock);
+            if (!in_use.owns_lock())
+              throw std::invalid_argument("this SolveReuse is in use by a solve");
+            r.reuse.clear();
+          },
+          "Free the kept solve.");
 
   py::class_<ProgressMonitor>(
       m, "ProgressMonitor",
@@ -544,6 +587,7 @@ void bind_solver(py::module_& m) {
         py::arg("leaf_links") = std::string(leaf_links_name(defaults.leaf_links)),
         py::arg("cluster_separation") = py::none(), py::arg("memory_limit") = py::none(),
         py::arg("pass_results") = false, py::arg("yield_to_interface") = false,
+        py::arg("reuse") = py::none(),
         "Hierarchical radiosity. oracle: 'standard' | 'perceptual' | 'gradient'; quality in\n"
         "[0, 1] (0: no refinement); max_elements, time_budget (s): budgets; visibility:\n"
         "'exact' | 'sampled' (rays per sample); bounces: fixed iteration count instead of\n"
@@ -559,7 +603,8 @@ void bind_solver(py::module_& m) {
         "progress gets pass, passes (fixed), phase, elements, leaves, links, seconds and fraction\n"
         "(never decreasing); with pass_results, the 'pass' reports carry 'result': that pass's\n"
         "solution, as solve() returns it. yield_to_interface: the solve's threads run at a lower\n"
-        "CPU priority than the process's others (a UI beside the solve).");
+        "CPU priority than the process's others (a UI beside the solve). reuse: a SolveReuse;\n"
+        "the solve relights the one it keeps when only the lighting changed (stats['reused']).");
   m.def(
       "quality_threshold",
       [](const std::string& oracle, double quality) {

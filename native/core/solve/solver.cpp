@@ -21,6 +21,7 @@
 #include "core/solve/gather.h"
 #include "core/solve/link_batch.h"
 #include "core/solve/refine.h"
+#include "core/solve/reuse.h"
 #include "core/solve/timing.h"
 #include "core/solve/yield_priority.h"
 #include "radiosity/solve.h"
@@ -79,13 +80,9 @@ double gigabytes(std::size_t bytes) { return std::round(static_cast<double>(byte
 
 class Solver {
  public:
-  Solver(const Scene& scene, const SolveOptions& options, const ProgressCallback& progress,
-         const CancelCheck& cancel)
+  Solver(const Scene& scene, const SolveOptions& options)
       : scene_(scene),
         options_(options),
-        progress_(progress),
-        cancel_(cancel),
-        start_(Clock::now()),
         hierarchy_(scene),
         occluders_(make_scene_occluders(scene)),
         evaluator_{hierarchy_,         occluders_,
@@ -93,16 +90,30 @@ class Solver {
                    options.oracle,     oracle_geometric_scale(options.oracle, scene.total_area)},
         direct_(hierarchy_, occluders_, options.visibility, options.rays, options.oracle,
                 oracle_geometric_scale(options.oracle, scene.total_area)),
-        limits_{options.min_element_area * scene.total_area, options.max_elements},
         roots_(hierarchy_.elements().size()),
-        memory_limit_(options.memory_limit.value_or(std::numeric_limits<std::size_t>::max())),
         clusters_(hierarchy_) {}
 
-  SolveResult run();
+  // The whole solve.
+  SolveResult run(const ProgressCallback& progress, const CancelCheck& cancel);
+  // Solves again with the elements and links of the last run or relight, after
+  // the scene's emission, reflectance or light colours changed (to values the
+  // links already reach: SolveReuse) and with `options`' limits; refinement
+  // goes on where the new radiances ask.
+  SolveResult relight(const SolveOptions& options, const ProgressCallback& progress,
+                      const CancelCheck& cancel);
+  // Whether the last run or relight completed (not cancelled or cut short by
+  // the time budget): only then do its hierarchy and links stand.
+  bool complete() const { return complete_; }
+  const SolveOptions& options() const { return options_; }
+  std::size_t memory_bytes() const { return stats_.element_bytes + stats_.link_bytes; }
 
  private:
+  void begin(const SolveOptions& options, const ProgressCallback& progress,
+             const CancelCheck& cancel);
+  void solve_passes();
+  SolveResult end();
   bool cancelled() const {
-    if (!stopped_ && cancel_ && cancel_()) stopped_ = true;
+    if (!stopped_ && cancel_ && *cancel_ && (*cancel_)()) stopped_ = true;
     return stopped_;
   }
   double elapsed() const { return seconds_since(start_); }
@@ -130,20 +141,21 @@ class Solver {
   void track_memory();
 
   const Scene& scene_;
-  const SolveOptions options_;
-  const ProgressCallback& progress_;
-  const CancelCheck& cancel_;
+  SolveOptions options_;
+  // The call's (run or relight).
+  const ProgressCallback* progress_ = nullptr;
+  const CancelCheck* cancel_ = nullptr;
   mutable std::atomic<bool> stopped_{false};  // read and set from worker threads
-  const Clock::time_point start_;
+  Clock::time_point start_;
   Hierarchy hierarchy_;
   SceneOccluders occluders_;
   LinkEvaluator evaluator_;
   DirectLight direct_;
   // Brightness the oracles' thresholds are relative to (refine()).
   double reference_radiance_ = 0.0;
-  const RefineLimits limits_;
-  const std::size_t roots_;         // elements before any split: every split adds four
-  const std::size_t memory_limit_;  // bytes of elements and links (SolveOptions::memory_limit)
+  RefineLimits limits_;
+  const std::size_t roots_;   // elements before any split: every split adds four
+  std::size_t memory_limit_;  // bytes of elements and links (SolveOptions::memory_limit)
   std::vector<Link> links_;
   // Links grouped by receiver for the gather, and which links they describe.
   std::vector<std::uint32_t> offset_, order_;
@@ -168,6 +180,7 @@ class Solver {
   int pass_ = 0, passes_ = 1;
   double fraction_ = 0.0;  // the last reported: progress never goes back
   double threshold_ = std::numeric_limits<double>::infinity();
+  bool complete_ = false;
   SolveStats stats_;
 };
 
@@ -175,7 +188,7 @@ class Solver {
 // fraction that never goes back.
 void Solver::report(SolvePhase phase, double fraction, const SolveResult* pass_result) {
   fraction_ = std::max(fraction_, std::clamp(fraction, 0.0, 1.0));
-  if (!progress_) return;
+  if (!progress_ || !*progress_) return;
   SolveProgress p;
   p.pass = pass_;
   p.passes = passes_;
@@ -193,7 +206,7 @@ void Solver::report(SolvePhase phase, double fraction, const SolveResult* pass_r
   p.seconds = elapsed();
   p.fraction = fraction_;
   p.pass_result = pass_result;
-  progress_(p);
+  (*progress_)(p);
 }
 
 // Where `within` (0 to 1) of the current pass lies in the whole solve:
@@ -506,13 +519,60 @@ void Solver::count(SolveStats& stats) const {
   stats.light_links = light_links_.size();
 }
 
-SolveResult Solver::run() {
+// What every call starts from: its options' limits, callbacks and clock, and
+// statistics of its own (the counts stay those of the solution).
+void Solver::begin(const SolveOptions& options, const ProgressCallback& progress,
+                   const CancelCheck& cancel) {
+  options_ = options;
+  progress_ = &progress;
+  cancel_ = &cancel;
+  stopped_ = false;
+  start_ = Clock::now();
+  limits_ = {options.min_element_area * scene_.total_area, options.max_elements};
+  memory_limit_ = options.memory_limit.value_or(std::numeric_limits<std::size_t>::max());
+  budget_hit_ = memory_hit_ = cut_short_ = refinement_cut_short_ = complete_ = false;
+  fraction_ = 0.0;
+  const SolveStats counts = stats_;
+  stats_ = SolveStats{};
+  stats_.element_bytes = counts.element_bytes;
+  stats_.link_bytes = counts.link_bytes;
+  stats_.stopped_by = StopReason::Quality;
+}
+
+SolveResult Solver::run(const ProgressCallback& progress, const CancelCheck& cancel) {
+  begin(options_, progress, cancel);
   thresholds_ = pass_thresholds();
   passes_ = static_cast<int>(thresholds_.size());
   report(SolvePhase::Linking, 0.0);
   link_initially();
-  stats_.stopped_by = StopReason::Quality;
   if (!cancelled()) snapshot(std::numeric_limits<double>::infinity());  // emitters only
+  solve_passes();
+  return end();
+}
+
+SolveResult Solver::relight(const SolveOptions& options, const ProgressCallback& progress,
+                            const CancelCheck& cancel) {
+  begin(options, progress, cancel);
+  stats_.reused = true;
+  // One pass at the target threshold: the kept solution already passed the
+  // coarser ones, with the old radiances as the start.
+  thresholds_ = {pass_thresholds().back()};
+  passes_ = 1;
+  report(SolvePhase::Linking, 0.0);
+  // Which sides reflect and what the lights give changed: regroup (the energy
+  // balance depends on who reflects) and gather the light links anew.
+  ++links_version_;
+  ++light_version_;
+  // Converge on the kept elements first: refinement decided on radiances half
+  // way from the old lighting to the new would split what neither needs.
+  iterate(std::numeric_limits<double>::infinity(), options_.max_iterations, 1e-3);
+  solve_passes();
+  return end();
+}
+
+// The passes of decreasing threshold, each iterated to convergence, until the
+// last, a budget or cancel.
+void Solver::solve_passes() {
   for (pass_ = 0; pass_ < passes_; ++pass_) {
     if (cancelled()) break;
     threshold_ = thresholds_[static_cast<size_t>(pass_)];
@@ -537,11 +597,17 @@ SolveResult Solver::run() {
       break;
     }
   }
+}
+
+SolveResult Solver::end() {
   if (refinement_cut_short_) stats_.stopped_by = StopReason::TimeBudget;
   if (cancelled()) {
     stats_.cancelled = true;
     stats_.stopped_by = StopReason::Cancel;
   }
+  // The hierarchy and links stand only if no evaluation of links was cut short
+  // (linking, or a pass abandoned half-refined) and a pass gathered over them.
+  complete_ = !cancelled() && !cut_short_ && !refinement_cut_short_ && stats_.passes > 0;
   // The counts stay those of the last snapshot: the solution returned.
   stats_.skipped_faces = scene_.skipped.size();
   stats_.repaired_faces = scene_.repaired.size();
@@ -549,7 +615,11 @@ SolveResult Solver::run() {
   stats_.seconds = elapsed();
   result_.stats = stats_;
   report(SolvePhase::Done, 1.0);
-  return std::move(result_);
+  progress_ = nullptr;  // the call's, gone after it
+  cancel_ = nullptr;
+  SolveResult out = std::move(result_);
+  result_ = SolveResult{};
+  return out;
 }
 
 }  // namespace
@@ -569,8 +639,31 @@ double quality_threshold(Oracle oracle, double quality) {
   return range.coarse * std::pow(range.fine / range.coarse, q);
 }
 
+// A complete solve and the scene it was made for (the solver refers to it),
+// whose lighting each relight replaces.
+struct SolveReuse::Kept {
+  Scene scene;
+  std::unique_ptr<Solver> solver;
+};
+
+SolveReuse::SolveReuse() = default;
+SolveReuse::~SolveReuse() = default;
+
+void SolveReuse::clear() { kept_.reset(); }
+
+std::size_t SolveReuse::memory_bytes() const {
+  return kept_ ? kept_->solver->memory_bytes() +
+                     (kept_->scene.patches.size() + kept_->scene.occluders.size()) * sizeof(Patch)
+               : 0;
+}
+
+std::string SolveReuse::refusal(const Scene& scene, const SolveOptions& options) const {
+  if (!kept_) return "no solve is kept";
+  return relight_refusal(kept_->scene, kept_->solver->options(), scene, options);
+}
+
 SolveResult solve(const Scene& scene, const SolveOptions& options, const ProgressCallback& progress,
-                  const CancelCheck& cancel) {
+                  const CancelCheck& cancel, SolveReuse* reuse) {
   if (!(options.quality >= 0.0 && options.quality <= 1.0)) {
     throw std::invalid_argument("quality must lie in [0, 1]");
   }
@@ -607,8 +700,25 @@ SolveResult solve(const Scene& scene, const SolveOptions& options, const Progres
     yielding.emplace(arena);
     lower_this_thread_priority();  // the calling thread works in the arena too
   }
-  SolveResult result =
-      arena.execute([&] { return Solver(scene, checked, progress, cancel).run(); });
+  SolveResult result = arena.execute([&] {
+    if (!reuse) return Solver(scene, checked).run(progress, cancel);
+    std::string refusal = reuse->refusal(scene, checked);
+    if (refusal.empty()) {
+      SolveReuse::Kept& kept = *reuse->kept_;
+      take_lighting(kept.scene, scene);
+      SolveResult relit = kept.solver->relight(checked, progress, cancel);
+      if (!kept.solver->complete()) reuse->clear();
+      return relit;
+    }
+    reuse->clear();  // its memory is the new solve's
+    auto kept = std::make_unique<SolveReuse::Kept>();
+    kept->scene = scene;
+    kept->solver = std::make_unique<Solver>(kept->scene, checked);
+    SolveResult solved = kept->solver->run(progress, cancel);
+    solved.stats.reuse_refusal = std::move(refusal);
+    if (kept->solver->complete()) reuse->kept_ = std::move(kept);
+    return solved;
+  });
   require_finite(result.mesh);
   return result;
 }

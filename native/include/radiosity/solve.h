@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -166,6 +167,8 @@ struct SolveStats {
   std::size_t skipped_faces = 0;
   std::size_t repaired_faces = 0;  // solved after a repair (Scene::repaired)
   bool cancelled = false;
+  bool reused = false;        // relit with the elements and links of a kept solve (SolveReuse)
+  std::string reuse_refusal;  // with a SolveReuse not reused: why (SolveReuse::refusal)
   StopReason stopped_by = StopReason::Quality;
   double seconds = 0.0;
   double seconds_linking = 0.0;
@@ -191,10 +194,41 @@ using ProgressCallback = std::function<void(const SolveProgress&)>;
 // Polled often from the solving thread; true stops the solve.
 using CancelCheck = std::function<bool()>;
 
+// The elements and links of the last complete solve, kept so that a change of
+// lighting alone (emission, reflectance, the lights' colours and strengths)
+// solves again without linking: form factors and visibility depend on the
+// geometry only. solve() with a SolveReuse relights when it can (refusal() is
+// empty) and otherwise solves from nothing and keeps that. It holds the
+// solve's memory until cleared or destroyed. One solve at a time may use it.
+class SolveReuse {
+ public:
+  SolveReuse();
+  ~SolveReuse();
+  SolveReuse(const SolveReuse&) = delete;
+  SolveReuse& operator=(const SolveReuse&) = delete;
+
+  bool holds() const { return kept_ != nullptr; }
+  void clear();
+  std::size_t memory_bytes() const;
+  // Why `scene` cannot be relit with `options` from what is kept ("" if it can):
+  // nothing kept; options other than the limits changed; the geometry changed;
+  // a light was added, removed, turned on or off; a surface emits or reflects
+  // that did not before (the links it needs were never made).
+  std::string refusal(const Scene& scene, const SolveOptions& options) const;
+
+ private:
+  friend SolveResult solve(const Scene&, const SolveOptions&, const ProgressCallback&,
+                           const CancelCheck&, SolveReuse*);
+  struct Kept;
+  std::unique_ptr<Kept> kept_;
+};
+
 // Solves; throws std::invalid_argument for bad options. When `cancelled`
 // turns true (set from another thread) the solve returns the last complete
-// pass promptly.
+// pass promptly. With `reuse`: relights from it when it can, and keeps this
+// solve in it if it completes (or clears it).
 SolveResult solve(const Scene& scene, const SolveOptions& options,
-                  const ProgressCallback& progress = {}, const CancelCheck& cancelled = {});
+                  const ProgressCallback& progress = {}, const CancelCheck& cancelled = {},
+                  SolveReuse* reuse = nullptr);
 
 }  // namespace radiosity
