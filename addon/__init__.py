@@ -29,14 +29,14 @@ if "bpy" in locals():
 
     for _name in ("native", "compat", "arrays", "light_units", "surface_uv", "bake_materials", "result_state",
                   "export", "bake", "scene_transaction", "display_colours", "game_export", "properties",
-                  "pipeline", "operators", "ui"):
+                  "progress_text", "live_pacing", "solve_reuse", "pipeline", "operators", "ui"):
         if _name in locals():
             importlib.reload(locals()[_name])
 
 import bpy
 from bpy.props import PointerProperty
 
-from . import game_export, native, operators, properties, ui
+from . import game_export, native, operators, properties, solve_reuse, ui
 
 # Registration order matters: a PropertyGroup before the group that points to it.
 classes = (
@@ -64,6 +64,7 @@ def register():
         description="Radiosity solver settings",
     )
     ui.register()  # menu entries, the progress bar's property
+    solve_reuse.register()
     # Try the native module now so the panel can say at once if it is unusable;
     # registration itself never depends on it.
     try:
@@ -73,6 +74,7 @@ def register():
 
 
 def unregister():
+    solve_reuse.unregister()
     ui.unregister()
     del bpy.types.Scene.radiosity
     for cls in reversed(classes):

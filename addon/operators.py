@@ -22,7 +22,7 @@ import traceback
 import bpy
 from bpy.types import Operator
 
-from . import bake, live_pacing, native, pipeline, result_state
+from . import bake, live_pacing, native, pipeline, result_state, solve_reuse
 from .progress_text import status_line
 
 # The interactive solve in progress (at most one: the operator is modal), so
@@ -207,8 +207,9 @@ class RADIOSITY_OT_solve(Operator):
             return self._unexpected(err)
         if stats.warning:
             self.report({'WARNING'}, stats.warning)
-        self.report({'INFO'}, "Radiosity: %s, %s elements in %.2f s"
-                    % (stats.status.lower(), "{:,}".format(stats.elements), stats.seconds))
+        self.report({'INFO'}, "Radiosity: %s%s, %s elements in %.2f s"
+                    % (stats.status.lower(), " (relit: only the lighting had changed)" if stats.relit else "",
+                       "{:,}".format(stats.elements), stats.seconds))
         return {'FINISHED'}
 
     def _unexpected(self, err):
@@ -251,5 +252,6 @@ class RADIOSITY_OT_clear(Operator):
         scene = context.scene
         result_state.clear(scene, context.view_layer)
         bake.remove_original_attributes(scene)
+        solve_reuse.forget(scene)
         scene.radiosity.stats.clear()
         return {'FINISHED'}

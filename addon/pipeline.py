@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import bake, export, game_export, result_state, scene_transaction
+from . import bake, export, game_export, result_state, scene_transaction, solve_reuse
 
 STATUS = {
     "quality": "Converged",
@@ -24,6 +24,10 @@ STATUS = {
     "time_budget": "Time budget reached",
     "cancel": "Cancelled (last complete pass kept)",
 }
+
+
+# The native refusal when no solve of the scene was kept yet.
+NOTHING_KEPT = "no solve is kept"
 
 
 class SolveError(Exception):
@@ -45,6 +49,7 @@ class Job:
     oracle_label: str
     progress: dict = field(default_factory=dict)  # the solver's last report
     monitor: object = None  # the native ProgressMonitor of an interactive solve
+    reuse: object = None  # the scene's native SolveReuse (solve_reuse.py)
     result: object = None
     error: BaseException = None
     started: float = field(default_factory=time.perf_counter)  # when the Solve began
@@ -128,13 +133,13 @@ def prepare(context, solver, started=None):
     options = native_options(settings.solver_options(), native_scene.total_area)
     options["time_budget"] = solve_budget(settings.time_budget, started, 2 * native_scene.patch_count)
     return Job(scene_name=scene.name, exported=exported, native_scene=native_scene, options=options,
-               oracle_label=label, started=started)
+               oracle_label=label, started=started, reuse=solve_reuse.for_scene(solver, scene))
 
 
 def solve(solver, job, progress=None):
     """The native solve on the calling thread; `progress` is called with the solver's reports."""
     try:
-        job.result = solver.solve(job.native_scene, progress=progress, **job.options)
+        job.result = solver.solve(job.native_scene, progress=progress, reuse=job.reuse, **job.options)
     except REFUSALS as err:
         raise SolveError("Radiosity: %s" % err) from None
 
@@ -145,7 +150,7 @@ def work(solver, job, token):
     try:
         # The window's thread keeps its priority: Esc, redraws and the timer that
         # shows the passes stay prompt while the solve takes every idle cycle.
-        job.result = solver.solve(job.native_scene, progress=job.monitor, cancel=token,
+        job.result = solver.solve(job.native_scene, progress=job.monitor, cancel=token, reuse=job.reuse,
                                   yield_to_interface=job.monitor is not None, **job.options)
     except BaseException as err:  # reported on the main thread
         job.error = err
@@ -299,5 +304,9 @@ def record(context, job, stats, skipped_objects, warnings):
     s.links = int(stats.get("links", 0))
     s.iterations = int(stats.get("iterations", 0))
     s.seconds = float(stats.get("seconds", 0.0))
+    s.relit = bool(stats.get("reused", False))
+    # Why a solve that could have relit linked anew (nothing said the first time).
+    refusal = str(stats.get("reuse_refusal", ""))
+    s.relinked_because = refusal if refusal and refusal != NOTHING_KEPT else ""
     s.warning = "; ".join(warnings)
     return s

@@ -107,6 +107,18 @@ class RadiosityStats(PropertyGroup):
         min=0.0,
         unit='TIME_ABSOLUTE',
     )
+    relit: BoolProperty(
+        name="Relit",
+        description=(
+            "The last solve started from the elements and links of the one before it: only "
+            "lights, emission or colours had changed"
+        ),
+        default=False,
+    )
+    relinked_because: StringProperty(
+        name="Linked Anew",
+        description="Why the last solve could not start from the one before it",
+    )
     warning: StringProperty(
         name="Warning",
         description="What the last solve could not model (for example point lights), and other notes",
@@ -115,9 +127,10 @@ class RadiosityStats(PropertyGroup):
     def clear(self):
         """Forget the last solve."""
         self.valid = False
-        self.status = self.oracle = self.warning = ""
+        self.status = self.oracle = self.warning = self.relinked_because = ""
         self.elements = self.links = self.iterations = 0
         self.seconds = 0.0
+        self.relit = False
 
 
 def _update_wireframe(settings, context):

@@ -236,6 +236,10 @@ def draw_stats(layout, context, stats):
         layout.label(text="Not solved yet", icon='INFO')
         return
     draw_wrapped(layout, context, stats.status)
+    if stats.relit:
+        draw_wrapped(layout, context, "Relit: only the lighting had changed", icon='LIGHT')
+    elif stats.relinked_because:
+        draw_wrapped(layout, context, "Linked anew: " + stats.relinked_because)
     col = layout.column(align=True)
     for name, value in (("Oracle", stats.oracle),
                         ("Elements", "{:,}".format(stats.elements)),

@@ -18,7 +18,7 @@ import unittest
 import bpy
 import numpy as np
 
-from radiosity import bake, native, operators, pipeline, result_state
+from radiosity import bake, native, operators, pipeline, result_state, solve_reuse
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "scenes")))
 import build_scene  # noqa: E402
@@ -278,6 +278,70 @@ class SolveCubeTest(unittest.TestCase):
         self.assertTrue(all(o.show_wire for o in result_state.result_objects(scene)))
         scene.radiosity.show_wireframe = False
         self.assertFalse(any(o.show_wire for o in result_state.result_objects(scene)))
+
+
+class RelightTest(unittest.TestCase):
+    """A second solve after only the lighting changed starts from the first's
+    elements and links (addon/solve_reuse.py); any other change links anew and
+    the statistics say why."""
+
+    def setUp(self):
+        self.scene = open_scene("cube")
+        self.addCleanup(solve_reuse.forget)
+
+    def light_strength(self):
+        return bpy.data.materials["Light"].node_tree.nodes["Emission"].inputs["Strength"]
+
+    def means(self):
+        return {name: attribute(obj).mean(axis=0) for name, obj in results(self.scene).items()}
+
+    def test_a_stronger_light_relights_to_what_a_solve_from_nothing_gives(self):
+        bpy.ops.radiosity.solve()
+        stats = self.scene.radiosity.stats
+        self.assertFalse(stats.relit)
+        self.assertEqual(stats.relinked_because, "")  # nothing was kept before
+        self.assertGreater(solve_reuse.kept_bytes(self.scene), 0)
+        # Every radiance doubles, so no refinement decision changes (they read
+        # radiances relative to the adaptation level): the same meshes, twice as
+        # bright, to the solve's tolerance.
+        first = {name: attribute(obj) for name, obj in results(self.scene).items()}
+        self.light_strength().default_value *= 2.0
+        bpy.ops.radiosity.solve()
+        self.assertTrue(stats.relit, stats.relinked_because)
+        relit = {name: attribute(obj) for name, obj in results(self.scene).items()}
+        self.assertEqual(first.keys(), relit.keys())
+        bright = max(float(v.max()) for v in relit.values())
+        for name in first:
+            self.assertEqual(relit[name].shape, first[name].shape, name)
+            np.testing.assert_allclose(relit[name], 2.0 * first[name], rtol=0, atol=1e-4 * bright, err_msg=name)
+
+    def test_a_new_wall_colour_relights_close_to_a_solve_from_nothing(self):
+        bpy.ops.radiosity.solve()
+        bsdf = bpy.data.materials["Red"].node_tree.nodes["Principled BSDF"]
+        bsdf.inputs["Base Color"].default_value = (0.2, 0.3, 0.8, 1.0)
+        bpy.ops.radiosity.solve()
+        self.assertTrue(self.scene.radiosity.stats.relit, self.scene.radiosity.stats.relinked_because)
+        relit = self.means()
+        solve_reuse.forget(self.scene)
+        bpy.ops.radiosity.solve()
+        self.assertFalse(self.scene.radiosity.stats.relit)
+        fresh = self.means()
+        for name in fresh:
+            np.testing.assert_allclose(relit[name], fresh[name], rtol=0.02, atol=1e-4, err_msg=name)
+
+    def test_a_moved_object_links_anew_and_says_why(self):
+        bpy.ops.radiosity.solve()
+        self.scene.objects["Cube"].location.x += 0.1
+        bpy.ops.radiosity.solve()
+        stats = self.scene.radiosity.stats
+        self.assertFalse(stats.relit)
+        self.assertEqual(stats.relinked_because, "the geometry changed")
+
+    def test_remove_result_forgets_the_kept_solve(self):
+        bpy.ops.radiosity.solve()
+        self.assertGreater(solve_reuse.kept_bytes(self.scene), 0)
+        bpy.ops.radiosity.clear()
+        self.assertEqual(solve_reuse.kept_bytes(self.scene), 0)
 
 
 class DoubledWallTest(unittest.TestCase):

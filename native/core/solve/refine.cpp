@@ -38,6 +38,26 @@ double adaptation_radiance(const Hierarchy& hierarchy) {
   return mean > 0.0 ? kAdaptationCalibration * mean : hierarchy.scene().reference_radiance();
 }
 
+std::vector<double> relative_luminance(const Hierarchy& hierarchy) {
+  const double adaptation = adaptation_radiance(hierarchy);
+  std::vector<double> out;
+  out.reserve(hierarchy.elements().size());
+  for (const Element& e : hierarchy.elements())
+    out.push_back(adaptation > 0.0 ? luminance(e.radiance) / adaptation : 0.0);
+  return out;
+}
+
+double relative_luminance_change(const Hierarchy& hierarchy, const std::vector<double>& before) {
+  const std::vector<double> now = relative_luminance(hierarchy);
+  double delta = 0.0, total = 0.0;
+  for (size_t i = 0; i < now.size() && i < before.size(); ++i) {
+    const double area = hierarchy.elements()[i].area;
+    delta += std::abs(now[i] - before[i]) * area;
+    total += now[i] * area;
+  }
+  return total > 0.0 ? delta / total : 0.0;
+}
+
 // Then the form factor varies over that end in ways five samples (receiver)
 // or a split in four (emitter shape) cannot follow: it grows quickly towards
 // a shared edge. Such links follow a split end down instead.

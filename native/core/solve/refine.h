@@ -37,6 +37,15 @@ struct RefineLimits {
 // emitting sides as the solution stands (solver's reference brightness).
 double adaptation_radiance(const Hierarchy& hierarchy);
 
+// Each element's luminance relative to the adaptation level: what the oracles'
+// decisions read (a light made brighter scales every radiance and changes none).
+std::vector<double> relative_luminance(const Hierarchy& hierarchy);
+
+// How far the relative luminances moved since `before` (relative_luminance of
+// the same elements): the area-weighted mean change over the mean, as the
+// solve's residual measures change. Below 1e-3, refinement decisions stand.
+double relative_luminance_change(const Hierarchy& hierarchy, const std::vector<double>& before);
+
 // Is one end of the link closer to the other than twice its own radius?
 bool near_field(const Hierarchy& hierarchy, const Link& link, bool receiver_end);
 

@@ -57,6 +57,9 @@ double cluster_separation(const SolveOptions& options) {
                                           : 2.0 + 8.0 * options.quality;
 }
 
+// Radiance change since the last refinement when not known: refine first.
+constexpr double kUnknownDrift = std::numeric_limits<double>::infinity();
+
 // Shadow rays that measure a cluster link's visible fraction.
 constexpr int kClusterRays = 16;
 
@@ -110,7 +113,7 @@ class Solver {
  private:
   void begin(const SolveOptions& options, const ProgressCallback& progress,
              const CancelCheck& cancel);
-  void solve_passes();
+  void solve_passes(double drift);
   SolveResult end();
   bool cancelled() const {
     if (!stopped_ && cancel_ && *cancel_ && (*cancel_)()) stopped_ = true;
@@ -136,7 +139,8 @@ class Solver {
   void group_links();
   void gather_far_light();
   double gather_push_pull();
-  double iterate(double threshold, int max_iterations, double tolerance);
+  double iterate(double threshold, int max_iterations, double tolerance,
+                 double drift = kUnknownDrift);
   void snapshot(double threshold);
   void track_memory();
 
@@ -444,14 +448,15 @@ double Solver::gather_push_pull() {
                    balance_.down_scale(), direct_light_);
 }
 
-// Refine, gather, push/pull until converged (or `max_iterations`). Returns the
-// last residual.
-double Solver::iterate(double threshold, int max_iterations, double tolerance) {
+// Refine, gather, push/pull until converged (or `max_iterations`); refinement
+// waits until the radiances have moved by 1e-3 since `drift` was measured.
+// Returns the last residual.
+double Solver::iterate(double threshold, int max_iterations, double tolerance, double drift) {
   double residual = 0.0;
-  // Radiance change since refinement last found nothing to do: decisions can
-  // only change once the radiances they read have moved (a converging
-  // high-albedo scene iterates hundreds of times without new refinement).
-  double drift = std::numeric_limits<double>::infinity();
+  // `drift`: radiance change since refinement last found nothing to do:
+  // decisions can only change once the radiances they read have moved (a
+  // converging high-albedo scene iterates hundreds of times without new
+  // refinement).
   TailExtrapolation tail;
   for (int i = 0; i < max_iterations && !pass_abandoned(); ++i) {
     bool refined = false;
@@ -546,7 +551,7 @@ SolveResult Solver::run(const ProgressCallback& progress, const CancelCheck& can
   report(SolvePhase::Linking, 0.0);
   link_initially();
   if (!cancelled()) snapshot(std::numeric_limits<double>::infinity());  // emitters only
-  solve_passes();
+  solve_passes(kUnknownDrift);
   return end();
 }
 
@@ -564,24 +569,29 @@ SolveResult Solver::relight(const SolveOptions& options, const ProgressCallback&
   ++links_version_;
   ++light_version_;
   // Converge on the kept elements first: refinement decided on radiances half
-  // way from the old lighting to the new would split what neither needs.
-  iterate(std::numeric_limits<double>::infinity(), options_.max_iterations, 1e-3);
-  solve_passes();
+  // way from the old lighting to the new would split what neither needs. Then
+  // refine only if the radiances moved relative to the adaptation level, which
+  // is what the oracles read: a light made brighter changes no decision.
+  const std::vector<double> before = relative_luminance(hierarchy_);
+  iterate(std::numeric_limits<double>::infinity(), options_.max_iterations, options_.tolerance);
+  solve_passes(relative_luminance_change(hierarchy_, before));
   return end();
 }
 
 // The passes of decreasing threshold, each iterated to convergence, until the
-// last, a budget or cancel.
-void Solver::solve_passes() {
+// last, a budget or cancel. `drift`: how far the radiances moved since the
+// hierarchy was last refined for them (iterate).
+void Solver::solve_passes(double drift) {
   for (pass_ = 0; pass_ < passes_; ++pass_) {
     if (cancelled()) break;
     threshold_ = thresholds_[static_cast<size_t>(pass_)];
     const bool last = pass_ + 1 == passes_;
     if (options_.bounces) {
-      iterate(threshold_, *options_.bounces, -1.0);
+      iterate(threshold_, *options_.bounces, -1.0, drift);
     } else {
-      iterate(threshold_, options_.max_iterations, last ? options_.tolerance : 1e-3);
+      iterate(threshold_, options_.max_iterations, last ? options_.tolerance : 1e-3, drift);
     }
+    drift = kUnknownDrift;  // a new threshold: every link is judged again
     if (pass_abandoned()) break;
     snapshot(threshold_);
     stats_.passes = pass_ + 1;
