@@ -37,6 +37,7 @@ class ArrayScene:
     """A scene exported from Blender (bench/blender_export.py), solvable like a SceneBuilder."""
 
     def __init__(self, path):
+        self.path = path
         self.arrays = np.load(path)
         self.faces = self.arrays["face_sizes"]
 

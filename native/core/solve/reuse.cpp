@@ -69,6 +69,16 @@ std::string relight_refusal(const Scene& kept, const SolveOptions& kept_options,
   return "";
 }
 
+double lighting_scale(const Scene& kept, const Scene& scene) {
+  auto lighting = [](const Scene& s) {
+    double sum = s.emitted_power;
+    for (const Light& light : s.lights) sum += luminance(light.colour);
+    return sum;
+  };
+  const double before = lighting(kept), after = lighting(scene);
+  return before > 0.0 && after > 0.0 ? after / before : 1.0;
+}
+
 void take_lighting(Scene& kept, const Scene& scene) {
   for (size_t i = 0; i < kept.patches.size(); ++i) {
     for (size_t s = 0; s < 2; ++s) {

@@ -21,6 +21,11 @@ namespace radiosity {
 std::string relight_refusal(const Scene& kept, const SolveOptions& kept_options, const Scene& scene,
                             const SolveOptions& options);
 
+// About how much brighter `scene`'s lighting is than `kept`'s: the ratio of
+// their emitted power plus the lights' luminances, exact when every emitter and
+// light changed by the same factor; 1 when either has none.
+double lighting_scale(const Scene& kept, const Scene& scene);
+
 // Copies `scene`'s lighting (emission, reflectance, light colours and the
 // emitted power) into `kept`, which has the same geometry (relight_refusal).
 void take_lighting(Scene& kept, const Scene& scene);

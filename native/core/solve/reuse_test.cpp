@@ -90,6 +90,14 @@ TEST(RelightRefusal, TakeLightingCopiesTheLightingOnly) {
   EXPECT_EQ(kept.emitted_power, brighter.emitted_power);
 }
 
+TEST(RelightRefusal, LightingScaleIsTheEmittedPowerRatio) {
+  EXPECT_DOUBLE_EQ(lighting_scale(room().scene(), room(4.0).scene()), 4.0);
+  EXPECT_DOUBLE_EQ(lighting_scale(room().scene(), room(1.0, 0.9).scene()), 1.0);
+  // Emission added elsewhere counts as its power.
+  const Scene two = room(1.0, 0.5, 1.0).scene();
+  EXPECT_GT(lighting_scale(room().scene(), two), 1.0);
+}
+
 // Through solve(): the second solve relights (no link evaluated) and its
 // radiance is the first's times the lamp's factor of 4, an exact scaling.
 TEST(SolveReuse, RelightsAStrongerLampWithoutLinking) {

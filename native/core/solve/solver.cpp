@@ -59,6 +59,8 @@ double cluster_separation(const SolveOptions& options) {
 
 // Radiance change since the last refinement when not known: refine first.
 constexpr double kUnknownDrift = std::numeric_limits<double>::infinity();
+// The threshold of an iteration that refines nothing.
+constexpr double kNoRefinement = std::numeric_limits<double>::infinity();
 
 // Shadow rays that measure a cluster link's visible fraction.
 constexpr int kClusterRays = 16;
@@ -102,7 +104,8 @@ class Solver {
   // the scene's emission, reflectance or light colours changed (to values the
   // links already reach: SolveReuse) and with `options`' limits; refinement
   // goes on where the new radiances ask.
-  SolveResult relight(const SolveOptions& options, const ProgressCallback& progress,
+  // `scale`: about how much brighter the new lighting is (the start's guess).
+  SolveResult relight(const SolveOptions& options, double scale, const ProgressCallback& progress,
                       const CancelCheck& cancel);
   // Whether the last run or relight completed (not cancelled or cut short by
   // the time budget): only then do its hierarchy and links stand.
@@ -555,8 +558,8 @@ SolveResult Solver::run(const ProgressCallback& progress, const CancelCheck& can
   return end();
 }
 
-SolveResult Solver::relight(const SolveOptions& options, const ProgressCallback& progress,
-                            const CancelCheck& cancel) {
+SolveResult Solver::relight(const SolveOptions& options, double scale,
+                            const ProgressCallback& progress, const CancelCheck& cancel) {
   begin(options, progress, cancel);
   stats_.reused = true;
   // One pass at the target threshold: the kept solution already passed the
@@ -571,10 +574,20 @@ SolveResult Solver::relight(const SolveOptions& options, const ProgressCallback&
   // Converge on the kept elements first: refinement decided on radiances half
   // way from the old lighting to the new would split what neither needs. Then
   // refine only if the radiances moved relative to the adaptation level, which
-  // is what the oracles read: a light made brighter changes no decision.
+  // is what the oracles read: a light made brighter changes no decision. The
+  // start is the old solution scaled like the lighting (exact when every light
+  // changed alike); a change clear at 1e-3 needs no further convergence first.
   const std::vector<double> before = relative_luminance(hierarchy_);
-  iterate(std::numeric_limits<double>::infinity(), options_.max_iterations, options_.tolerance);
-  solve_passes(relative_luminance_change(hierarchy_, before));
+  for (std::int32_t e = 0; e < static_cast<std::int32_t>(hierarchy_.elements().size()); ++e)
+    hierarchy_.element(e).radiance *= scale;
+  constexpr double kClearChange = 1e-2;
+  iterate(kNoRefinement, options_.max_iterations, 1e-3);
+  double drift = relative_luminance_change(hierarchy_, before);
+  if (drift < kClearChange) {
+    iterate(kNoRefinement, options_.max_iterations, options_.tolerance);
+    drift = relative_luminance_change(hierarchy_, before);
+  }
+  solve_passes(drift);
   return end();
 }
 
@@ -715,8 +728,9 @@ SolveResult solve(const Scene& scene, const SolveOptions& options, const Progres
     std::string refusal = reuse->refusal(scene, checked);
     if (refusal.empty()) {
       SolveReuse::Kept& kept = *reuse->kept_;
+      const double scale = lighting_scale(kept.scene, scene);
       take_lighting(kept.scene, scene);
-      SolveResult relit = kept.solver->relight(checked, progress, cancel);
+      SolveResult relit = kept.solver->relight(checked, scale, progress, cancel);
       if (!kept.solver->complete()) reuse->clear();
       return relit;
     }
