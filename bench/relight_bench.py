@@ -104,7 +104,7 @@ def measure(rad, arrays, oracle, quality, change, repeats):
         same_mesh = False
     first, again = statistics.median(first_times), statistics.median(relight_times)
     return dict(first_s=round(first, 3), relight_s=round(again, 3), ratio=round(again / first, 3),
-                reused=relit.stats["reused"], leaves_first_fresh=fresh.stats["leaves"],
+                reused=relit.stats["reused"], leaves_fresh=fresh.stats["leaves"],
                 leaves_relit=relit.stats["leaves"], iterations=relit.stats["iterations"],
                 same_mesh=same_mesh, max_difference=float("%.2g" % difference))
 

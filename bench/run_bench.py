@@ -7,7 +7,10 @@
    of repetitions, JSON in <build>/bench/<program>.json.
 2. The solver sweep (bench/solver_bench.py): elements, links, time and memory
    per oracle and quality, CSV in <build>/bench/solver.csv.
-3. The speed-accuracy study (bench/study.py, the source's Chapter 7): sweeps,
+3. Relighting (bench/relight_bench.py): a solve again after only the
+   lighting changed, against the first solve and a solve from nothing;
+   <build>/bench/relight.csv.
+4. The speed-accuracy study (bench/study.py, the source's Chapter 7): sweeps,
    snapshots, error against a refined solution and a Cycles render, Cycles
    bake comparison; <build>/bench/study.csv, study_*.png and report.md. Quick
    mode: fewer points, smaller images, fewer samples (a few minutes).
@@ -41,6 +44,9 @@ def main():
                "--blender", args.blender]
     command += ["--quick", "--repeats", "1"] if args.quick else []
     subprocess.run(command, check=True)
+    print("== relighting", flush=True)
+    subprocess.run([sys.executable, str(ROOT / "bench" / "relight_bench.py"), "--build", args.build,
+                    "--blender", args.blender] + (["--quick"] if args.quick else []), check=True)
     print("== speed-accuracy study", flush=True)
     subprocess.run([sys.executable, str(ROOT / "bench" / "study.py"), "--build", args.build, "--blender",
                     args.blender, "--mode", "quick" if args.quick else "full"], check=True)
