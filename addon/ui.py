@@ -19,7 +19,7 @@ import bpy
 from bpy.props import FloatProperty
 from bpy.types import Menu, Panel
 
-from . import compat, native, operators, result_state
+from . import compat, native, operators, result_state, solve_reuse
 from .progress_text import progress_fraction, progress_texts
 
 EDIT_WARNING = "Edits to radiosity results are replaced by the next Solve"
@@ -240,6 +240,10 @@ def draw_stats(layout, context, stats):
         draw_wrapped(layout, context, "Relit: only the lighting had changed", icon='LIGHT')
     elif stats.relinked_because:
         draw_wrapped(layout, context, "Linked anew: " + stats.relinked_because)
+    kept = solve_reuse.kept_bytes(context.scene)
+    if kept:
+        # What the next Solve can start from, and the memory that costs.
+        draw_wrapped(layout, context, "Kept to relight: %.0f MB" % max(kept / 2**20, 1))
     col = layout.column(align=True)
     for name, value in (("Oracle", stats.oracle),
                         ("Elements", "{:,}".format(stats.elements)),

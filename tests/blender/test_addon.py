@@ -340,6 +340,21 @@ class PanelTest(unittest.TestCase):
         self.assertEqual(labels, ["Converged", "Oracle", "Perceptual", "Elements", "12,345", "Links", "67,890",
                                   "Iterations", "4", "Time", "1.50 s", "2 point lights not modelled"])
 
+    def test_statistics_say_whether_the_solve_relit(self):
+        stats = bpy.context.scene.radiosity.stats
+        stats.valid, stats.status, stats.oracle = True, "Converged", "Perceptual"
+        try:
+            stats.relit = True
+            relit = self.draw(ui.RENDER_PT_radiosity_stats).record["labels"]
+            stats.relit, stats.relinked_because = False, "the geometry changed"
+            layout = self.draw(ui.RENDER_PT_radiosity_stats)
+        finally:
+            stats.clear()
+        # Wrapped to the panel's width: read as one text.
+        self.assertIn("Relit: only the lighting had changed", " ".join(relit))
+        self.assertIn("Linked anew: the geometry changed", " ".join(layout.record["labels"]))
+        self.assert_fits(layout)
+
     def test_labels_fit_the_default_width(self):
         for panel in PANELS:
             with self.subTest(panel=panel.bl_label):

@@ -153,6 +153,18 @@ class RelightTest(unittest.TestCase):
         self.assertFalse(reuse.holds)
         reuse.clear()  # clearing nothing is harmless
 
+    def test_a_failed_relight_is_not_kept(self):
+        reuse = rad.SolveReuse()
+        self.solve("perceptual", reuse)
+
+        def fail(report):
+            raise RuntimeError("the caller's progress callback failed")
+
+        with self.assertRaisesRegex(RuntimeError, "progress callback failed"):
+            rad.solve(scene(self.builder, emission_scale=2.0), oracle="perceptual", quality=QUALITY, reuse=reuse,
+                      progress=fail)
+        self.assertFalse(reuse.holds)
+
     def test_one_solve_at_a_time_per_reuse(self):
         reuse = rad.SolveReuse()
         errors = []

@@ -723,7 +723,7 @@ SolveResult solve(const Scene& scene, const SolveOptions& options, const Progres
     yielding.emplace(arena);
     lower_this_thread_priority();  // the calling thread works in the arena too
   }
-  SolveResult result = arena.execute([&] {
+  auto run = [&] {
     if (!reuse) return Solver(scene, checked).run(progress, cancel);
     std::string refusal = reuse->refusal(scene, checked);
     if (refusal.empty()) {
@@ -742,9 +742,15 @@ SolveResult solve(const Scene& scene, const SolveOptions& options, const Progres
     solved.stats.reuse_refusal = std::move(refusal);
     if (kept->solver->complete()) reuse->kept_ = std::move(kept);
     return solved;
-  });
-  require_finite(result.mesh);
-  return result;
+  };
+  try {
+    SolveResult result = arena.execute(run);
+    require_finite(result.mesh);
+    return result;
+  } catch (...) {
+    if (reuse) reuse->clear();  // a relight that failed half way leaves nothing to trust
+    throw;
+  }
 }
 
 }  // namespace radiosity
