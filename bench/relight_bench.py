@@ -17,7 +17,6 @@ Writes <build>/bench/relight.csv and relight.md.
 """
 
 import argparse
-import csv
 import pathlib
 import statistics
 import sys
@@ -27,7 +26,7 @@ import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))
-from solver_bench import BUNDLED, ORACLES, export_bundled  # noqa: E402
+from solver_bench import BUNDLED, ORACLES, export_bundled, write_results  # noqa: E402
 
 
 def make_scene(rad, arrays, emission=None, reflectance=None):
@@ -129,17 +128,7 @@ def main():
                            **measure(rad, arrays, oracle, args.quality, change, 1 if args.quick else args.repeats))
                 rows.append(row)
                 print(row, flush=True)
-    out = ROOT / args.build / "bench"
-    out.mkdir(parents=True, exist_ok=True)
-    with open(out / "relight.csv", "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
-        writer.writeheader()
-        writer.writerows(rows)
-    keys = list(rows[0].keys())
-    lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
-    lines += ["| " + " | ".join(str(r[k]) for k in keys) + " |" for r in rows]
-    (out / "relight.md").write_text("\n".join(lines) + "\n")
-    print(f"wrote {out / 'relight.csv'} and {out / 'relight.md'}")
+    write_results(rows, ROOT / args.build / "bench", "relight")
 
 
 if __name__ == "__main__":

@@ -101,13 +101,28 @@ def measure(rad, builder, oracle, quality, repeats, **options):
                 samples_occluded=s["samples_occluded"], samples_shared=s["samples_shared"])
 
 
-def markdown(rows):
-    keys = ("scene", "faces", "patches", "oracle", "quality", "visibility", "seconds", "scene_seconds", "cpu_seconds",
-            "leaves", "elements",
-            "links", "cluster_links", "bytes_per_element", "bytes_per_link", "peak_mb", "rss_mb", "linking_s")
+# The Markdown table's columns (the CSV has them all).
+MARKDOWN_KEYS = ("scene", "faces", "patches", "oracle", "quality", "visibility", "seconds", "scene_seconds",
+                 "cpu_seconds", "leaves", "elements", "links", "cluster_links", "bytes_per_element",
+                 "bytes_per_link", "peak_mb", "rss_mb", "linking_s")
+
+
+def markdown(rows, keys):
     lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
     lines += ["| " + " | ".join(str(r[k]) for k in keys) + " |" for r in rows]
     return "\n".join(lines) + "\n"
+
+
+def write_results(rows, out, stem, markdown_keys=None):
+    """`rows` (dicts with the same keys) as <out>/<stem>.csv and a Markdown table
+    <out>/<stem>.md of `markdown_keys` (default: every key)."""
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / (stem + ".csv"), "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        writer.writeheader()
+        writer.writerows(rows)
+    (out / (stem + ".md")).write_text(markdown(rows, markdown_keys or list(rows[0].keys())))
+    print(f"wrote {out / (stem + '.csv')} and {out / (stem + '.md')}")
 
 
 def main():
@@ -145,14 +160,7 @@ def main():
         if faces <= args.exact_faces:
             run("box_field", field, "standard", 0.0, 1, visibility="exact")
 
-    out = ROOT / args.build / "bench"
-    out.mkdir(parents=True, exist_ok=True)
-    with open(out / "solver.csv", "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
-        writer.writeheader()
-        writer.writerows(rows)
-    (out / "solver.md").write_text(markdown(rows))
-    print(f"wrote {out / 'solver.csv'} and {out / 'solver.md'}")
+    write_results(rows, ROOT / args.build / "bench", "solver", MARKDOWN_KEYS)
 
 
 if __name__ == "__main__":
