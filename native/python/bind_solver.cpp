@@ -30,16 +30,24 @@ struct CancelToken {
   std::atomic<bool> flag{false};
 };
 
+// A SolveReuse, the lock that keeps two solves from using it at once, and
+// what it holds as of its last solve or clear: read from Python (a panel's
+// draw) while a solve on another thread may be replacing it.
+struct PyReuse {
+  SolveReuse reuse;
+  std::mutex mutex;
+  std::atomic<bool> holds{false};
+  std::atomic<std::size_t> bytes{0};
+  void note() {  // with `mutex` held
+    holds = reuse.holds();
+    bytes = reuse.memory_bytes();
+  }
+};
+
 // What a solve running on another thread has reported, for a caller that polls
 // it (Blender's UI timer). The solver thread only copies under a mutex and
 // never waits for Python's GIL, so a busy interface cannot slow the solve (a
 // callback waits for the GIL at every report) and the solve cannot stall it.
-// A SolveReuse and the lock that keeps two solves from using it at once.
-struct PyReuse {
-  SolveReuse reuse;
-  std::mutex mutex;
-};
-
 struct ProgressMonitor {
   std::mutex mutex;
   std::optional<SolveProgress> latest;     // its pass_result cleared
@@ -398,8 +406,16 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
       if (!in_use.owns_lock())
         throw std::invalid_argument("this SolveReuse is in use by another solve");
     }
-    py::gil_scoped_release release;
-    result = solve(scene, options, callback, cancelled, kept ? &kept->reuse : nullptr);
+    {
+      py::gil_scoped_release release;
+      try {
+        result = solve(scene, options, callback, cancelled, kept ? &kept->reuse : nullptr);
+      } catch (...) {
+        if (kept) kept->note();
+        throw;
+      }
+    }
+    if (kept) kept->note();
   }
   if (callback_error) std::rethrow_exception(callback_error);
   return to_python(std::move(result));
@@ -430,10 +446,11 @@ void bind_solver(py::module_& m) {
       "and strengths changed; otherwise that solve starts from nothing and is kept instead.")
       .def(py::init<>())
       .def_property_readonly(
-          "holds", [](PyReuse& r) { return r.reuse.holds(); }, "whether a solve is kept")
+          "holds", [](PyReuse& r) { return r.holds.load(); },
+          "whether a solve is kept (as of the last solve with it)")
       .def_property_readonly(
-          "memory_bytes", [](PyReuse& r) { return r.reuse.memory_bytes(); },
-          "bytes the kept solve holds")
+          "memory_bytes", [](PyReuse& r) { return r.bytes.load(); },
+          "bytes the kept solve holds (as of the last solve with it)")
       .def(
           "clear",
           [](PyReuse& r) {
@@ -441,6 +458,7 @@ void bind_solver(py::module_& m) {
             if (!in_use.owns_lock())
               throw std::invalid_argument("this SolveReuse is in use by a solve");
             r.reuse.clear();
+            r.note();
           },
           "Free the kept solve.");
 

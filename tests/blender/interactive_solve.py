@@ -23,6 +23,7 @@ nothing; the add-on's own pacing (live_pacing.py) bounds what is left.
 """
 
 import json
+import os
 import subprocess
 import sys
 import time
@@ -74,7 +75,6 @@ def show_the_panel():
 
 
 def screenshot_in_progress():
-    import os
     win = window()
     with bpy.context.temp_override(window=win, screen=win.screen, area=win.screen.areas[0]):
         bpy.ops.screen.screenshot(filepath=os.path.join(SHOTS, "solve_in_progress.png"))

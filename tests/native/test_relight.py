@@ -170,8 +170,10 @@ class RelightTest(unittest.TestCase):
         errors = []
 
         def progress(report):
-            # Inside the first solve, which holds the reuse: a second must refuse at once.
+            # Inside the first solve, which holds the reuse: a second must refuse at
+            # once; what it holds reads as of before this solve (nothing yet).
             if not errors:
+                errors.append((reuse.holds, reuse.memory_bytes))
                 try:
                     rad.solve(scene(self.builder), quality=0.0, reuse=reuse)
                     errors.append(None)
@@ -188,8 +190,10 @@ class RelightTest(unittest.TestCase):
             rad.solve(scene(self.builder), quality=0.3, reuse=reuse, progress=progress)))
         worker.start()
         worker.join()
-        self.assertEqual(errors, ["this SolveReuse is in use by another solve", "this SolveReuse is in use by a solve"])
+        self.assertEqual(errors, [(False, 0), "this SolveReuse is in use by another solve",
+                                  "this SolveReuse is in use by a solve"])
         self.assertTrue(done and reuse.holds)
+        self.assertGreater(reuse.memory_bytes, 0)
 
     def test_reuse_must_be_a_solve_reuse(self):
         with self.assertRaisesRegex(ValueError, "reuse must be a SolveReuse"):
