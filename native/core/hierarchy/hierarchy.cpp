@@ -202,6 +202,14 @@ double inset_at(const Patch& p, const dvec3& v) {
 
 }  // namespace
 
+bool Hierarchy::samples_inset(const Element& e) const {
+  if (!has_insets(e)) return false;
+  const Patch& patch = patch_of(e);
+  for (int k = 0; k < e.corner_count; ++k)
+    if (inset_at(patch, vertices_[e.corner[static_cast<size_t>(k)]]) > 0.0) return true;
+  return false;
+}
+
 int Hierarchy::samples(const Element& e, dvec3* out) const {
   const dvec3 c = centre(e);
   const Patch& patch = patch_of(e);

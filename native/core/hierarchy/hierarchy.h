@@ -73,6 +73,9 @@ class Hierarchy {
     const auto& inset = patch_of(e).edge_inset;
     return inset[0] > 0.0f || inset[1] > 0.0f || inset[2] > 0.0f || inset[3] > 0.0f;
   }
+  // Whether some corner sample of the element does sit further in: a corner
+  // on an inset edge. Elements inside such a patch sample as any other.
+  bool samples_inset(const Element& e) const;
 
   // Splits a leaf into four children (no-op if already split); returns the
   // first child. Children inherit the parent's radiance.

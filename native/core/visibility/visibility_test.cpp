@@ -199,6 +199,25 @@ TEST(VisiblePolygon, ExactMatchesMonteCarlo) {
   std::printf("exact vs Monte Carlo: worst deviation %.2f standard errors\n", worst_sigmas);
 }
 
+// The value-only path (no vertex generators, no gradient) walks the same
+// visible pieces: the same F to rounding, occluded or not, hidden or not.
+TEST(VisiblePolygon, FormFactorAloneEqualsTheGradientPathsValue) {
+  std::mt19937_64 rng(11);
+  int occluded = 0, hidden = 0;
+  for (int i = 0; i < 300; ++i) {
+    const Configuration c = random_configuration(rng, i % 7, i % 2 ? 0.25 : 0.8);
+    const double with_gradient = visible_f(c.r, c.n, c.emitter, c.occluders);
+    const double alone = visible_form_factor(c.r, c.n, c.emitter, c.occluders);
+    const double open = form_factor(c.r, c.n, c.emitter);
+    EXPECT_NEAR(alone, with_gradient, 1e-12 * open) << "configuration " << i;
+    occluded += with_gradient < open * (1.0 - 1e-9) ? 1 : 0;
+    hidden += with_gradient == 0.0 ? 1 : 0;
+  }
+  // The configurations cover partly and wholly hidden emitters.
+  EXPECT_GT(occluded, 100);
+  EXPECT_GT(hidden, 0);
+}
+
 // Central differences of the exact occluded F at steps h and h/2; a sample is
 // trusted only where the two agree (no discontinuity within the stencil).
 TEST(VisiblePolygon, GradientMatchesFiniteDifferences) {

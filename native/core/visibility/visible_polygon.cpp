@@ -100,6 +100,7 @@ struct Workspace {
   std::vector<double> dist;
   std::vector<HalfPlane> halves;
   std::vector<ContourVertex> contour;
+  std::vector<dvec3> positions;  // a piece for F alone
 
   std::int32_t add_line(const EdgeLine& e) {
     lines.push_back(e);
@@ -577,18 +578,34 @@ bool compute_visible_pieces(const dvec3& r, const dvec3& n, std::span<const dvec
 // Vertices on the horizon can land a rounding error below it; the kernel would
 // clip them again and make slivers, so they are lifted onto the upper side,
 // within the emitter plane (a shift of about 1e-15 of the scene's size).
-std::span<const ContourVertex> contour_of(Workspace& w, std::span<const PlaneVertex> piece) {
-  const dvec3 n_plane = w.n - glm::dot(w.n, w.frame.normal) * w.frame.normal;
-  const double n_plane2 = glm::dot(n_plane, n_plane);
-  const double lift = 4e-16 * (glm::length(w.r) + glm::length(w.frame.origin) + w.size);
-  w.contour.clear();
-  for (const PlaneVertex& v : piece) {
+struct HorizonLift {
+  dvec3 n_plane;
+  double n_plane2, lift;
+  explicit HorizonLift(const Workspace& w)
+      : n_plane(w.n - glm::dot(w.n, w.frame.normal) * w.frame.normal),
+        n_plane2(glm::dot(n_plane, n_plane)),
+        lift(4e-16 * (glm::length(w.r) + glm::length(w.frame.origin) + w.size)) {}
+  dvec3 operator()(const Workspace& w, const PlaneVertex& v) const {
     dvec3 pos = w.frame.to_space(v.p);
     const double h = glm::dot(w.n, pos - w.r);
     if (h < 0.0 && n_plane2 > 0.0) pos += ((lift - h) / n_plane2) * n_plane;
-    w.contour.push_back(resolve(v.tag, pos, w));
+    return pos;
   }
+};
+
+std::span<const ContourVertex> contour_of(Workspace& w, std::span<const PlaneVertex> piece) {
+  const HorizonLift lifted(w);
+  w.contour.clear();
+  for (const PlaneVertex& v : piece) w.contour.push_back(resolve(v.tag, lifted(w, v), w));
   return w.contour;
+}
+
+// The same piece as plain positions, for F alone (no vertex generators needed).
+std::span<const dvec3> positions_of(Workspace& w, std::span<const PlaneVertex> piece) {
+  const HorizonLift lifted(w);
+  w.positions.clear();
+  for (const PlaneVertex& v : piece) w.positions.push_back(lifted(w, v));
+  return w.positions;
 }
 
 std::span<const PlaneVertex> piece(const Workspace& w, std::size_t i) {
@@ -680,6 +697,19 @@ FormFactorGradient visible_form_factor_gradient(const dvec3& r, const dvec3& n,
   for (std::size_t i = 0; i + 1 < w.start.size(); ++i)
     total.add(form_factor_gradient(r, n, contour_of(w, piece(w, i))));
   return total.finish(unoccluded.value);
+}
+
+double visible_form_factor(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter,
+                           std::span<const Triangle> occluders) {
+  Workspace& w = thread_workspace();
+  bool occluded = false;
+  if (!compute_visible_pieces(r, n, emitter, occluders, w, occluded)) return 0.0;
+  const double unoccluded = form_factor(r, n, emitter);
+  if (!occluded) return unoccluded;
+  PieceSum total;
+  for (std::size_t i = 0; i + 1 < w.start.size(); ++i)
+    total.add({form_factor(r, n, positions_of(w, piece(w, i))), dvec3(0.0)});
+  return total.finish(unoccluded).value;
 }
 
 void visible_form_factor_gradient_parts(const dvec3& r, const dvec3& n,

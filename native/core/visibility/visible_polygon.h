@@ -66,6 +66,11 @@ FormFactorGradient visible_form_factor_gradient(const dvec3& r, const dvec3& n,
                                                 std::span<const dvec3> emitter,
                                                 std::span<const Triangle> occluders);
 
+// The visible form factor alone, without its gradient (cheaper: the pieces'
+// vertices need no generating lines).
+double visible_form_factor(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter,
+                           std::span<const Triangle> occluders);
+
 // The same for several parts of one emitter at once (the children of a split
 // emitter element: convex, counter-clockwise, on the emitter's plane, inside
 // it): the visible region of the whole emitter is computed once, with
