@@ -129,15 +129,28 @@ void hand_down_links(const Hierarchy& hierarchy, SolveOptions::LeafLinks leaf_li
                      SplitLinks& links) {
   if (leaf_links == SolveOptions::LeafLinks::None) return;
   const bool all = leaf_links == SolveOptions::LeafLinks::All;
+  enum Down : std::uint8_t { Stays, ToReceiverChildren, ToEmitterChildren };
   const auto hand_down = [&](const std::vector<Link>& from, std::vector<Link>& staying,
                              std::vector<Link>& moved) {
-    for (const Link& link : from) {
+    // Decided in parallel (the distances are most of the work), applied in order.
+    std::vector<Down> down(from.size(), Stays);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, from.size()), [&](const auto& range) {
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        const Link& link = from[i];
+        if (!hierarchy.element(link.receiver).is_leaf() &&
+            (all || near_field(hierarchy, link, true)))
+          down[i] = ToReceiverChildren;
+        else if (all && !hierarchy.element(link.emitter).is_leaf() &&
+                 near_field(hierarchy, link, false))
+          down[i] = ToEmitterChildren;
+      }
+    });
+    for (size_t i = 0; i < from.size(); ++i) {
+      const Link& link = from[i];
       const Element& receiver = hierarchy.element(link.receiver);
       const Element& emitter = hierarchy.element(link.emitter);
-      const bool receiver_down = !receiver.is_leaf() && (all || near_field(hierarchy, link, true));
-      const bool emitter_down =
-          !receiver_down && all && !emitter.is_leaf() && near_field(hierarchy, link, false);
-      if (!receiver_down && !emitter_down) {
+      const bool receiver_down = down[i] == ToReceiverChildren;
+      if (down[i] == Stays) {
         staying.push_back(link);
         continue;
       }
