@@ -134,22 +134,26 @@ class InteractiveSolveTest(unittest.TestCase):
         # polling, status, live passes and redraws must not starve it. Esc keeps
         # the last complete pass, a step in time, so Esc comes halfway between
         # two passes of a headless solve of the same scene, measured just
-        # before; the window keeps the earlier pass only if it runs at least
-        # (that pass's time / Esc time) as fast, about 80 % here.
+        # before: the first pass completed after 40 % of the headless solve's
+        # time and the next (any faster solver keeps this test meaningful);
+        # the window keeps the earlier pass only if it runs at least (that
+        # pass's time / Esc time) as fast, about 80 % here.
         # Two timings compared on a shared machine: a burst of other load during
         # one of them fails it, so a second attempt (both measured again) may
         # pass; a window truly slower fails both.
         for attempt in range(2):
             completed, headless_after = headless_timeline("full_office", 1.0, (2.0, 4.0, 6.0), passes_after=4.0)
             times = sorted((t, leaves) for t, leaves in completed.values())
-            kept_pass = next(i for i, (t, _) in enumerate(times[:-1]) if t >= 4.0)
+            self.assertGreaterEqual(len(times), 2, completed)
+            kept_pass = next(i for i, (t, _) in enumerate(times[:-1])
+                             if t >= 0.4 * times[-1][0] or i == len(times) - 2)
             esc = 0.5 * (times[kept_pass][0] + times[kept_pass + 1][0])
             headless_kept = times[kept_pass][1]
             r = self.run_window("full_office", "cancel_after:%.2f" % esc)
             print("Esc after %.1f s: the window kept %d elements, headless %d; refined after 2/4/6 s: "
                   "window %s, headless %s" % (esc, r["elements"], headless_kept,
                                               "/".join(str(r["leaves_after"].get(str(m), "-")) for m in (2.0, 4.0, 6.0)),
-                                              "/".join(str(headless_after[m]) for m in (2.0, 4.0, 6.0))))
+                                              "/".join(str(headless_after.get(m, "-")) for m in (2.0, 4.0, 6.0))))
             self.assertEqual(r["status"], "Cancelled (last complete pass kept)", r)
             if r["elements"] >= 0.8 * headless_kept:
                 break
