@@ -81,6 +81,15 @@ def _version():
     return ".".join(map(str, version)) if version else "VERSION"
 
 
+def loaded():
+    """The module, or None if it cannot be loaded (for what only adds detail, such
+    as the panel's reading of Quality)."""
+    try:
+        return load()
+    except NativeUnavailable:
+        return None
+
+
 def version():
     """The native module's version string, or None if it cannot be loaded."""
     try:

@@ -41,6 +41,11 @@ ORACLE_ITEMS = (
     ('GRADIENT', "Gradient",
      "Adds detail where the shading changes how quickly it brightens or darkens, as in "
      "penumbrae and light falloff (irradiance gradient difference)"),
+    ('NOTICEABLE', "Noticeable",
+     "Adds detail where the mesh's shading would differ visibly from the true lighting, "
+     "judged as the eye does: against the brightness around it, and less for details "
+     "too small to resolve. Quality reads as a number of just noticeable differences: "
+     "the fewest elements for a clean picture (Weber contrast on Secchia's gradients)"),
 )
 
 VISIBILITY_ITEMS = (
@@ -146,8 +151,9 @@ class RadiositySettings(PropertyGroup):
         name="Oracle",
         description=(
             "Where the lighting gets more detail: where the eye would notice (Perceptual), "
-            "wherever much light varies (Standard) or where the shading's slope changes "
-            "(Gradient). Technically, the refinement oracle"
+            "wherever much light varies (Standard), where the shading's slope changes "
+            "(Gradient) or where the mesh would differ visibly from the true lighting "
+            "(Noticeable). Technically, the refinement oracle"
         ),
         items=ORACLE_ITEMS,
         default=SOLVER_DEFAULTS["oracle"].upper(),

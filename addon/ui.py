@@ -21,6 +21,7 @@ from bpy.types import Menu, Panel
 
 from . import compat, native, operators, result_state, solve_reuse
 from .progress_text import progress_fraction, progress_texts
+from .quality_meaning import quality_text
 
 EDIT_WARNING = "Edits to radiosity results are replaced by the next Solve"
 # Width of a character of the UI font at scale 1, above the widest lines of the texts
@@ -179,6 +180,11 @@ class RENDER_PT_radiosity_quality(RadiosityPanel, Panel):
         col = layout.column()
         col.prop(settings, "oracle")
         col.prop(settings, "quality", slider=True)
+        meaning = quality_text(settings, native.loaded())
+        if meaning:
+            row = col.row()
+            row.alignment = 'RIGHT'
+            row.label(text=meaning)
         col.prop(settings, "min_element_size")
 
         col = layout.column()

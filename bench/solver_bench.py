@@ -30,7 +30,7 @@ sys.path.insert(0, str(ROOT / "bench"))
 from synthetic_scenes import SceneBuilder, box_field, room_with_blocker  # noqa: E402
 
 BUNDLED = ("cube", "office", "full_office", "dining_room")
-ORACLES = ("standard", "perceptual", "gradient")
+ORACLES = ("standard", "perceptual", "gradient", "noticeable")
 
 
 class ArrayScene:

@@ -15,7 +15,9 @@ Why these numbers (measured on the 2-core development machine, solver of
   the Cycles comparison measure missing bounces instead of refinement.
 """
 
-ORACLES = ("standard", "perceptual", "gradient")
+ORACLES = ("standard", "perceptual", "gradient", "noticeable")
+# Column headings of the report.
+SHORT_NAMES = {"standard": "std", "perceptual": "perc", "gradient": "grad", "noticeable": "noti"}
 
 # Per scene: (lowest quality, highest quality) of the sweep, and the refined reference.
 SCENES = {

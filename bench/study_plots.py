@@ -14,7 +14,7 @@ import numpy as np  # noqa: E402
 import curves  # noqa: E402
 import study_config  # noqa: E402
 
-COLOURS = {"standard": "tab:blue", "perceptual": "tab:orange", "gradient": "tab:green"}
+COLOURS = {"standard": "tab:blue", "perceptual": "tab:orange", "gradient": "tab:green", "noticeable": "tab:red"}
 METRICS = (("dog_refined", "DoG error vs refined radiosity"), ("rms_refined", "plain RMS vs refined radiosity"),
            ("dog_cycles", "DoG error vs Cycles path traced"), ("rms_cycles", "plain RMS vs Cycles path traced"))
 # Signed, so on a linear axis beside the error metrics (which remove or dilute brightness).

@@ -29,7 +29,7 @@ def main():
     parser.add_argument("--build", default="build", help="build directory")
     parser.add_argument("--blender", default="blender", help="Blender executable")
     parser.add_argument("--scene", default="office", choices=sorted(SCENES))
-    parser.add_argument("--oracle", default="PERCEPTUAL", choices=("STANDARD", "PERCEPTUAL", "GRADIENT"))
+    parser.add_argument("--oracle", default="PERCEPTUAL", choices=("STANDARD", "PERCEPTUAL", "GRADIENT", "NOTICEABLE"))
     parser.add_argument("--samples", type=int, default=32, help="Cycles samples of the render")
     parser.add_argument("-v", "--verbose", action="store_true", help="show Blender's output")
     args = parser.parse_args()

@@ -49,7 +49,7 @@ import _radiosity as rad  # noqa: E402
 
 np.seterr(all="ignore")
 
-ORACLES = ["standard", "perceptual", "gradient", "bf", ""]
+ORACLES = ["standard", "perceptual", "gradient", "noticeable", "bf", ""]
 
 
 def number(fdp, hostile=True):

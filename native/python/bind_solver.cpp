@@ -283,8 +283,8 @@ py::dict progress_dict(const SolveProgress& p) {
 Oracle read_oracle(const std::string& name) {
   const auto oracle = parse_oracle(name);
   if (!oracle) {
-    throw std::invalid_argument("oracle must be 'standard', 'perceptual' or 'gradient', got '" +
-                                name + "'");
+    throw std::invalid_argument(
+        "oracle must be 'standard', 'perceptual', 'gradient' or 'noticeable', got '" + name + "'");
   }
   return *oracle;
 }
@@ -606,7 +606,8 @@ void bind_solver(py::module_& m) {
         py::arg("cluster_separation") = py::none(), py::arg("memory_limit") = py::none(),
         py::arg("pass_results") = false, py::arg("yield_to_interface") = false,
         py::arg("reuse") = py::none(),
-        "Hierarchical radiosity. oracle: 'standard' | 'perceptual' | 'gradient'; quality in\n"
+        "Hierarchical radiosity. oracle: 'standard' | 'perceptual' | 'gradient' |\n"
+        "'noticeable'; quality in\n"
         "[0, 1] (0: no refinement); max_elements, time_budget (s): budgets; visibility:\n"
         "'exact' | 'sampled' (rays per sample); bounces: fixed iteration count instead of\n"
         "convergence; threads; progress(dict) callback; cancel: CancelToken;\n"

@@ -43,7 +43,7 @@ NOISE_TARGET = dict(exposure=0.003, block=0.01)   # a tenth and a sixth of the t
 MASK_SAMPLES = 16
 # The solution has no noise of its own (emission only): samples anti-alias.
 SOLUTION_SAMPLES = 8
-ORACLES = ("STANDARD", "PERCEPTUAL", "GRADIENT")
+ORACLES = ("STANDARD", "PERCEPTUAL", "GRADIENT", "NOTICEABLE")
 QUALITIES = (0.3, 0.5, 0.8)
 
 # label: (scene, builder parameters)

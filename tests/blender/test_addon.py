@@ -14,7 +14,8 @@ import addon_utils
 import bpy
 
 import radiosity
-from radiosity import bake, native, operators, pipeline, progress_text, properties, result_state, ui
+from radiosity import (bake, native, operators, pipeline, progress_text, properties, quality_meaning, result_state,
+                       ui)
 from layout_check import DEFAULT_REGION_WIDTH, CheckedLayout, FakeContext, FakePanel, layout_width
 
 # Every type the add-on registers, by its base type and RNA name.
@@ -180,7 +181,8 @@ class DefaultsTest(unittest.TestCase):
 
     def test_enum_identifiers(self):
         rna = self.settings.bl_rna.properties
-        self.assertEqual(list(rna["oracle"].enum_items.keys()), ["STANDARD", "PERCEPTUAL", "GRADIENT"])
+        self.assertEqual(list(rna["oracle"].enum_items.keys()),
+                         ["STANDARD", "PERCEPTUAL", "GRADIENT", "NOTICEABLE"])
         self.assertEqual(list(rna["visibility"].enum_items.keys()), ["EXACT", "SAMPLED"])
         self.assertIn("REFINED", rna["output"].enum_items)
         self.assertIn("ORIGINAL", rna["output"].enum_items)
@@ -359,6 +361,35 @@ class PanelTest(unittest.TestCase):
         for panel in PANELS:
             with self.subTest(panel=panel.bl_label):
                 self.assert_fits(self.draw(panel))
+
+    def test_quality_reads_in_each_oracles_terms_and_fits(self):
+        # The line under the slider states the threshold Quality sets, so it moves
+        # with the slider; every oracle's text and name fit the default width.
+        settings = bpy.context.scene.radiosity
+        saved = settings.oracle, settings.quality
+        rad = native.load()
+        try:
+            for oracle in settings.bl_rna.properties["oracle"].enum_items.keys():
+                settings.oracle = oracle
+                texts = []
+                for quality in (0.2, 0.8):
+                    settings.quality = quality
+                    with self.subTest(oracle=oracle, quality=quality):
+                        layout = self.draw(ui.RENDER_PT_radiosity_quality)
+                        self.assert_fits(layout)
+                        threshold = rad.quality_threshold(oracle.lower(), quality)
+                        meaning = quality_meaning.quality_meaning(oracle, threshold)
+                        self.assertIn(meaning, layout.record["labels"])
+                        texts.append(meaning)
+                self.assertNotEqual(texts[0], texts[1], oracle)
+            settings.oracle, settings.quality = 'NOTICEABLE', 0.5
+            jnd = rad.quality_threshold("noticeable", 0.5)
+            self.assertIn("Differences below %.2g JND" % jnd, self.draw(ui.RENDER_PT_radiosity_quality).record["labels"])
+            settings.quality = 0.0
+            self.assertIn("No refinement: the coarsest lighting",
+                          self.draw(ui.RENDER_PT_radiosity_quality).record["labels"])
+        finally:
+            settings.oracle, settings.quality = saved
 
     def test_long_texts_are_wrapped_to_fit(self):
         stats = bpy.context.scene.radiosity.stats

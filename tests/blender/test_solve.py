@@ -99,7 +99,7 @@ class SolveCubeTest(unittest.TestCase):
         self.assertLess(counts[0.5], counts[0.0] / 2)
 
     def test_every_oracle(self):
-        for oracle in ('STANDARD', 'PERCEPTUAL', 'GRADIENT'):
+        for oracle in ('STANDARD', 'PERCEPTUAL', 'GRADIENT', 'NOTICEABLE'):
             with self.subTest(oracle=oracle):
                 scene = open_scene("cube")
                 scene.radiosity.oracle = oracle

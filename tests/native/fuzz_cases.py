@@ -46,7 +46,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
-ORACLES = ("standard", "perceptual", "gradient")
+ORACLES = ("standard", "perceptual", "gradient", "noticeable")
 
 
 class Finding(Exception):

@@ -49,7 +49,7 @@ class ModuleTest(unittest.TestCase):
         packaged = pathlib.Path(_radiosity.__file__).with_name("solver_defaults.json")
         defaults = json.loads(_radiosity.DEFAULTS_JSON)
         self.assertEqual(json.loads(packaged.read_text()), defaults)
-        self.assertIn(defaults["oracle"], ("standard", "perceptual", "gradient"))
+        self.assertIn(defaults["oracle"], ("standard", "perceptual", "gradient", "noticeable"))
         self.assertIn(defaults["visibility"], ("exact", "sampled"))
         self.assertTrue(0.0 < defaults["quality"] <= 1.0)
         self.assertTrue(1 <= defaults["rays"] <= defaults["max_rays"])

@@ -17,7 +17,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import _radiosity as rad  # noqa: E402
 from synthetic_scenes import SceneBuilder, box_field, room_with_blocker  # noqa: E402
 
-ORACLES = ("standard", "perceptual", "gradient")
+ORACLES = ("standard", "perceptual", "gradient", "noticeable")
 
 
 def polygons(result):

@@ -430,7 +430,8 @@ bool DirectLight::evaluate(LightLink& link) const {
                             std::span<const dvec3>(values.gradient, static_cast<size_t>(ns)),
                             hierarchy_.normal(receiver),
                             receiver.area,
-                            hierarchy_.diameter(receiver)};
+                            hierarchy_.diameter(receiver),
+                            resolvable_size(hierarchy_.scene().total_area)};
   link.oracle = static_cast<float>(oracle_geometry(oracle_, samples) / geometric_scale_);
   return true;
 }

@@ -1,6 +1,7 @@
 #include "core/solve/link_transport.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <limits>
 #include <vector>
@@ -144,24 +145,40 @@ double grid_visible_share(const LinkEnds& ends, int corner_count,
   return open > 0.0 ? visible / open : -1.0;
 }
 
-void conserve_energy(const Element& receiver, const LinkEnds& ends, bool unoccluded,
-                     SampleValues& values, const std::span<const Triangle>* grid_occluders) {
+// The interpolant's average of per-sample values: what the receiver gathers.
+double sample_average(int corner_count, const double* value) {
+  std::array<Rgb, kMaxSamples> v{};
+  for (int s = 0; s <= corner_count; ++s) v[static_cast<size_t>(s)] = Rgb(value[s]);
+  return Interpolant::average(corner_count, v).x;
+}
+
+// Returns how much more light occluders hide at one sample than at another
+// (the largest open-minus-visible form factor over the samples less the
+// smallest): a shadow's edge lies between them, and the light beside it
+// reaches about the open value, which the samples' reconstruction cannot show.
+double conserve_energy(const Element& receiver, const LinkEnds& ends, bool unoccluded,
+                       SampleValues& values, const std::span<const Triangle>* grid_occluders) {
   std::array<Rgb, kMaxSamples> open{}, in_front{};
   double visible[kMaxSamples] = {};
+  double hidden_most = 0.0, hidden_least = std::numeric_limits<double>::infinity();
   for (int s = 0; s < ends.ns; ++s) {
     const double f =
         unoccluded ? values.value[s] : form_factor(ends.x[s], ends.n, ends.emitter_polygon());
     open[static_cast<size_t>(s)] = Rgb(f);
     in_front[static_cast<size_t>(s)] = Rgb(f > 0.0 ? 1.0 : 0.0);
     visible[s] = f > 0.0 ? std::clamp(values.value[s] / f, 0.0, 1.0) : 0.0;
+    const double hidden = std::max(0.0, f - values.value[s]);
+    hidden_most = std::max(hidden_most, hidden);
+    hidden_least = std::min(hidden_least, hidden);
   }
+  const double shadow_contrast = hidden_most - std::min(hidden_least, hidden_most);
   const double average = Interpolant::average(receiver.corner_count, open).x;
   const double front = Interpolant::average(receiver.corner_count, in_front).x;
   // 1e-6: far pairs need fewer quadrature points than the kernel's default
   // (7 x 7 instead of 5 x 5 at a gap of three radii for 1e-8, which changed
   // no energy test's result beyond 1e-7).
   const double exact = patch_form_factor(ends.receiver_polygon(), ends.emitter_polygon(), 1e-6);
-  if (!(average > 0.0) || !(exact >= 0.0) || !(front > 0.0)) return;
+  if (!(average > 0.0) || !(exact >= 0.0) || !(front > 0.0)) return shadow_contrast;
   bool all_seen = true;
   for (int s = 0; s < ends.ns; ++s)
     all_seen &= open[static_cast<size_t>(s)].x <= 0.0 || visible[s] >= 1.0 - 1e-9;
@@ -179,9 +196,10 @@ void conserve_energy(const Element& receiver, const LinkEnds& ends, bool unocclu
       if (share >= 0.0 && seen_average > 0.0) scale = exact * share / seen_average;
     }
     for (int s = 0; s < ends.ns; ++s) values.value[s] *= scale;
-    return;
+    return shadow_contrast;
   }
   for (int s = 0; s < ends.ns; ++s) values.value[s] += (exact - average) * visible[s] / front;
+  return shadow_contrast;
 }
 
 // Stores the sample form factors and the oracle's geometric criterion; false
@@ -240,34 +258,54 @@ bool finish(const LinkEvaluator& evaluator, Link& link, const LinkEnds& ends, Sa
   // never refine.
   const bool skip_occluder_contacts = clear >= 2;
   size_t used = 0;
-  for (int s = 0; s < ends.ns; ++s) {
-    if (at_emitter[s] || (at_occluder[s] && skip_occluder_contacts)) continue;
+  const auto use = [&](int s) {
     oracle_x[used] = ends.x[s];
     oracle_value[used] = std::max(0.0, value[s]);
     oracle_grad[used] = grad[s];
     ++used;
+  };
+  for (int s = 0; s < ends.ns; ++s) {
+    if (!at_emitter[s] && !(at_occluder[s] && skip_occluder_contacts)) use(s);
   }
-  LinkSamples samples{std::span<const dvec3>(oracle_x, used),
-                      std::span<const double>(oracle_value, used),
-                      std::span<const dvec3>(oracle_grad, used),
-                      ends.n,
-                      receiver.area,
-                      hierarchy.diameter(receiver)};
-  link.oracle = used >= 2 ? static_cast<float>(oracle_geometry(evaluator.oracle, samples) /
-                                               evaluator.geometric_scale)
-                          : 0.0f;
+  const size_t with_tangents = used;
+  // Noticeable also reads the contact samples' values, which are
+  // finite: the light's rise towards a contact is what the mesh must show.
+  if (evaluator.oracle == Oracle::Noticeable) {
+    for (int s = 0; s < ends.ns; ++s) {
+      if (at_emitter[s] || (at_occluder[s] && skip_occluder_contacts)) use(s);
+    }
+  }
   timings.oracle += seconds_since(start);
 
   // The oracle judged the samples' shape; what is gathered also carries the
   // right total.
   const auto conserve_start = Clock::now();
   for (int s = 0; s < ends.ns; ++s) values.value[s] = std::max(0.0, values.value[s]);
+  const double before = sample_average(receiver.corner_count, values.value);
   const bool grid = !unoccluded && evaluator.visibility == VisibilityMode::Exact &&
                     hierarchy.samples_inset(receiver);
-  conserve_energy(receiver, ends, unoccluded, values, grid ? &candidates : nullptr);
+  const double shadow_contrast =
+      conserve_energy(receiver, ends, unoccluded, values, grid ? &candidates : nullptr);
   for (int s = 0; s < ends.ns; ++s)
     link.form_factor[static_cast<size_t>(s)] = static_cast<float>(values.value[s]);
   timings.form_factors += seconds_since(conserve_start);
+
+  const auto oracle_start = Clock::now();
+  LinkSamples samples{std::span<const dvec3>(oracle_x, used),
+                      std::span<const double>(oracle_value, used),
+                      std::span<const dvec3>(oracle_grad, used),
+                      ends.n,
+                      receiver.area,
+                      hierarchy.diameter(receiver),
+                      resolvable_size(hierarchy.scene().total_area),
+                      used - with_tangents,
+                      std::abs(sample_average(receiver.corner_count, values.value) - before),
+                      shadow_contrast};
+  link.oracle = with_tangents >= 1 && used >= 2
+                    ? static_cast<float>(oracle_geometry(evaluator.oracle, samples) /
+                                         evaluator.geometric_scale)
+                    : 0.0f;
+  timings.oracle += seconds_since(oracle_start);
   return true;
 }
 

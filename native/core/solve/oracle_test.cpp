@@ -117,8 +117,82 @@ TEST(GradientOracle, IsLargestTangentialGradientDifferenceTimesArea) {
   EXPECT_NEAR(tilted.geometry(Oracle::Gradient), 0.0, 1e-12);
 }
 
+// The visible-difference oracle on the same profiles: the error of the linear
+// reconstruction (the mesh's Gouraud shading) from the samples.
+TEST(NoticeableOracle, ALinearRampShowsNoError) {
+  const Profile p([](double x) { return 0.1 + 0.9 * x; }, [](double) { return 0.9; });
+  EXPECT_NEAR(p.geometry(Oracle::Noticeable), 0.0, 1e-12);
+}
+
+TEST(NoticeableOracle, ACurveIsJudgedWhereThePerceptualOraclesKIgnoresIt) {
+  // Light falling off along a wall: every slope points the same way (k = 0 in
+  // eq. 27, so the perceptual criterion is 0), yet the chord misses the curve.
+  const Profile p([](double x) { return 0.2 + 0.3 * x + 0.3 * x * x; },
+                  [](double x) { return 0.3 + 0.6 * x; });
+  EXPECT_NEAR(p.perceptual(), 0.0, 1e-12);
+  // Largest tangent miss: from x = 0 to x = 1, |0.2 + 0.3 - 0.8| = 0.3; half of it.
+  EXPECT_NEAR(p.geometry(Oracle::Noticeable), 0.15, 1e-12);
+}
+
+TEST(NoticeableOracle, APenumbraBetweenSamplesCountsHalfItsStep) {
+  const Profile p = penumbra(0.2, 0.2);  // flat tangents on both sides of the step
+  EXPECT_NEAR(p.geometry(Oracle::Noticeable), 0.45, 1e-12);
+}
+
+TEST(NoticeableOracle, TangentsAtAContactClaimNoMoreThanTheLargestSample) {
+  // A sample at a contact has a gradient without bound (MATH.md s3).
+  Profile p([](double x) { return 0.01 + 0.02 * x; }, [](double) { return 0.02; });
+  p.g[0] = {1e6, 0, 0};
+  EXPECT_NEAR(p.geometry(Oracle::Noticeable), 0.03, 1e-12);
+}
+
+TEST(NoticeableOracle, ValuesAtAContactAreReachedByTheOtherSamplesTangents) {
+  // The light rises towards a contact at x = 0 (sample 0 and 3, value-only,
+  // listed last): the ramp of the others misses them by 0.5 - 0.2.
+  Profile p([](double x) { return x == 0.0 ? 0.5 : 0.1 + 0.1 * x; }, [](double) { return 0.1; });
+  std::vector<size_t> order = {1, 2, 4, 0, 3};
+  Profile sorted = p;
+  for (size_t i = 0; i < order.size(); ++i) {
+    sorted.x[i] = p.x[order[i]], sorted.b[i] = p.b[order[i]], sorted.g[i] = {1e9, 0, 0};
+    if (i < 3) sorted.g[i] = p.g[order[i]];
+  }
+  const LinkSamples samples{sorted.x, sorted.b, sorted.g, {0, 0, 1}, 1.0, std::sqrt(2.0), 0.0, 2};
+  // Tangent at x = 1 (0.2, slope 0.1) reaches x = 0 at 0.1: misses 0.5 by 0.4.
+  EXPECT_NEAR(oracle_geometry(Oracle::Noticeable, samples), 0.2, 1e-12);
+  // Their own gradients (1e9 here) start no tangent: without the value-only
+  // count they would claim the cap, the largest sample.
+  LinkSamples all = samples;
+  all.value_only = 0;
+  EXPECT_NEAR(oracle_geometry(Oracle::Noticeable, all), 0.5, 1e-12);
+}
+
+TEST(NoticeableOracle, FadesForElementsNarrowerThanTheEyeResolves) {
+  const Profile p = penumbra(0.2, 0.2);
+  const auto geometry = [&](double area, double diameter, double resolvable) {
+    return oracle_geometry(Oracle::Noticeable,
+                           LinkSamples{p.x, p.b, p.g, {0, 0, 1}, area, diameter, resolvable});
+  };
+  // The unit square: width sqrt(2) x 1 / sqrt(2) = 1.
+  EXPECT_NEAR(geometry(1.0, std::sqrt(2.0), 0.5), 0.45, 1e-12);
+  EXPECT_NEAR(geometry(1.0, std::sqrt(2.0), 4.0), 0.45 / 4.0, 1e-12);
+  // A sliver as long but a tenth as wide is a tenth as visible.
+  EXPECT_NEAR(geometry(0.1, std::sqrt(2.0), 1.0), 0.045, 1e-12);
+}
+
+TEST(NoticeableOracle, ThresholdsAreJustNoticeableDifferencesAtTheReceiver) {
+  // Weber: one JND is 2 % of the receiver's radiance, above a floor of a fifth
+  // of the adaptation level in the dark.
+  EXPECT_NEAR(oracle_reference(Oracle::Noticeable, 1.0, 3.0), 0.02 * 3.2, 1e-15);
+  EXPECT_NEAR(oracle_reference(Oracle::Noticeable, 1.0, 0.0), 0.02 * 0.2, 1e-15);
+  // Scaling every radiance scales the reference: decisions do not change.
+  EXPECT_NEAR(oracle_reference(Oracle::Noticeable, 7.0, 21.0),
+              7.0 * oracle_reference(Oracle::Noticeable, 1.0, 3.0), 1e-15);
+  // The source's oracles stay relative to the adaptation level alone.
+  EXPECT_EQ(oracle_reference(Oracle::Perceptual, 0.5, 3.0), 0.5);
+}
+
 TEST(Oracle, NamesRoundTrip) {
-  for (Oracle o : {Oracle::Standard, Oracle::Perceptual, Oracle::Gradient}) {
+  for (Oracle o : {Oracle::Standard, Oracle::Perceptual, Oracle::Gradient, Oracle::Noticeable}) {
     EXPECT_EQ(parse_oracle(oracle_name(o)), o);
   }
   EXPECT_FALSE(parse_oracle("bf").has_value());

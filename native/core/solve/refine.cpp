@@ -72,12 +72,20 @@ bool near_field(const Hierarchy& hierarchy, const Link& link, bool receiver_end)
 // Split the larger of receiver and emitter unless it is at the minimum size,
 // then the other.
 Split choose_split(const Hierarchy& hierarchy, const Link& link, double threshold,
-                   double reference_radiance, const RefineLimits& limits) {
+                   const DecisionScale& scale, const RefineLimits& limits) {
   const Element& p = hierarchy.element(link.receiver);
   const Element& q = hierarchy.element(link.emitter);
   const double brightness = luminance(hierarchy.reflectance(p) * q.radiance);
-  if (!(brightness / reference_radiance * link.oracle > threshold)) return Split::None;
-  const bool receiver_first = p.area >= q.area;
+  if (!(brightness / scale.at(p) * link.oracle > threshold)) return Split::None;
+  // Noticeable judges what the receiver's samples show. A light's
+  // radiance is its uniform emission, so splitting it changes no light the
+  // link carries, only how the same error is shared out among four links:
+  // links from lights split their receiver first (from reflecting surfaces,
+  // whose radiance varies, the larger end, as the others).
+  const bool from_light = luminance(hierarchy.emission(q)) >= 0.5 * luminance(q.radiance);
+  const bool receiver_first =
+      p.area >= q.area || (scale.oracle == Oracle::Noticeable && from_light &&
+                           limits.can_split(hierarchy, link.receiver));
   const std::int32_t first = receiver_first ? link.receiver : link.emitter;
   const std::int32_t second = receiver_first ? link.emitter : link.receiver;
   if (limits.can_split(hierarchy, first)) return receiver_first ? Split::Receiver : Split::Emitter;
@@ -86,12 +94,12 @@ Split choose_split(const Hierarchy& hierarchy, const Link& link, double threshol
 }
 
 std::vector<Split> choose_splits(const Hierarchy& hierarchy, std::span<const Link> links,
-                                 double threshold, double reference_radiance,
+                                 double threshold, const DecisionScale& scale,
                                  const RefineLimits& limits) {
   std::vector<Split> decision(links.size(), Split::None);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, links.size()), [&](const auto& range) {
     for (size_t i = range.begin(); i != range.end(); ++i)
-      decision[i] = choose_split(hierarchy, links[i], threshold, reference_radiance, limits);
+      decision[i] = choose_split(hierarchy, links[i], threshold, scale, limits);
   });
   return decision;
 }
@@ -175,7 +183,7 @@ void hand_down_links(const Hierarchy& hierarchy, SolveOptions::LeafLinks leaf_li
 // split: one above the threshold splits its receiver.
 bool split_light_receivers(Hierarchy& hierarchy, std::span<const Light> lights,
                            std::span<const LightLink> links, double threshold,
-                           double reference_radiance, const RefineLimits& limits) {
+                           const DecisionScale& scale, const RefineLimits& limits) {
   std::vector<std::uint8_t> split(links.size(), 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, links.size()), [&](const auto& range) {
     for (size_t i = range.begin(); i != range.end(); ++i) {
@@ -185,9 +193,8 @@ bool split_light_receivers(Hierarchy& hierarchy, std::span<const Light> lights,
       // Light the samples miss splits the receiver when it would show (a
       // hundredth of the adaptation level) whatever the oracle: the oracle
       // can only judge what the samples see.
-      const bool missed = brightness * l.missed > kMissedLight * reference_radiance;
-      split[i] = p.is_leaf() &&
-                 (missed || brightness / reference_radiance * l.oracle > threshold) &&
+      const bool missed = brightness * l.missed > kMissedLight * scale.adaptation;
+      split[i] = p.is_leaf() && (missed || brightness / scale.at(p) * l.oracle > threshold) &&
                  limits.can_split(hierarchy, l.receiver);
     }
   });

@@ -13,6 +13,7 @@
 #include "core/hierarchy/hierarchy.h"
 #include "core/solve/direct_light.h"
 #include "core/solve/link_transport.h"
+#include "core/solve/oracle.h"
 #include "radiosity/solve.h"
 
 namespace radiosity {
@@ -46,16 +47,28 @@ std::vector<double> relative_luminance(const Hierarchy& hierarchy);
 // solve's residual measures change. Below 1e-3, refinement decisions stand.
 double relative_luminance_change(const Hierarchy& hierarchy, const std::vector<double>& before);
 
+// What a link's brightness x oracle value is divided by before it is compared
+// with the threshold (oracle_reference): the adaptation radiance, or for
+// Noticeable one just noticeable difference at the receiver.
+struct DecisionScale {
+  Oracle oracle = Oracle::Standard;
+  double adaptation = 1.0;  // adaptation_radiance()
+
+  double at(const Element& receiver) const {
+    return oracle_reference(oracle, adaptation, luminance(receiver.radiance));
+  }
+};
+
 // Is one end of the link closer to the other than twice its own radius?
 bool near_field(const Hierarchy& hierarchy, const Link& link, bool receiver_end);
 
 // Which end of the link to split at this threshold, if any.
 Split choose_split(const Hierarchy& hierarchy, const Link& link, double threshold,
-                   double reference_radiance, const RefineLimits& limits);
+                   const DecisionScale& scale, const RefineLimits& limits);
 
 // The decision for every link (in parallel; the same for any thread count).
 std::vector<Split> choose_splits(const Hierarchy& hierarchy, std::span<const Link> links,
-                                 double threshold, double reference_radiance,
+                                 double threshold, const DecisionScale& scale,
                                  const RefineLimits& limits);
 
 // One round of splitting: the links that stay, and the unevaluated links made
@@ -83,7 +96,7 @@ void hand_down_links(const Hierarchy& hierarchy, SolveOptions::LeafLinks leaf_li
 // refused a split.
 bool split_light_receivers(Hierarchy& hierarchy, std::span<const Light> lights,
                            std::span<const LightLink> links, double threshold,
-                           double reference_radiance, const RefineLimits& limits);
+                           const DecisionScale& scale, const RefineLimits& limits);
 
 // Replaces every light link whose receiver has been split by its four
 // children's (unevaluated, returned); the others stay in `links`.

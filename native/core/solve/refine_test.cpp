@@ -41,29 +41,56 @@ struct FloorAndLamp {
 TEST(ChooseSplit, SplitsOnlyAboveTheThreshold) {
   const FloorAndLamp s(1.0, 1.0, 1.0);
   const RefineLimits limits{1e-6, {}};
-  EXPECT_EQ(choose_split(s.h, s.link(1.0f), 0.49, 1.0, limits), Split::Receiver);
-  EXPECT_EQ(choose_split(s.h, s.link(1.0f), 0.51, 1.0, limits), Split::None);
+  EXPECT_EQ(choose_split(s.h, s.link(1.0f), 0.49, DecisionScale{Oracle::Standard, 1.0}, limits),
+            Split::Receiver);
+  EXPECT_EQ(choose_split(s.h, s.link(1.0f), 0.51, DecisionScale{Oracle::Standard, 1.0}, limits),
+            Split::None);
   // Twice the reference brightness halves the criterion.
-  EXPECT_EQ(choose_split(s.h, s.link(1.0f), 0.3, 2.0, limits), Split::None);
+  EXPECT_EQ(choose_split(s.h, s.link(1.0f), 0.3, DecisionScale{Oracle::Standard, 2.0}, limits),
+            Split::None);
   // A link from an emitter that sends nothing is never worth splitting.
   FloorAndLamp dark(1.0, 1.0, 1.0);
   dark.h.element(dark.lamp()).radiance = Rgb(0.0);
-  EXPECT_EQ(choose_split(dark.h, dark.link(1e6f), 1e-9, 1.0, limits), Split::None);
+  EXPECT_EQ(
+      choose_split(dark.h, dark.link(1e6f), 1e-9, DecisionScale{Oracle::Standard, 1.0}, limits),
+      Split::None);
 }
 
 TEST(ChooseSplit, SplitsTheLargerEnd) {
   const RefineLimits limits{1e-6, {}};
   const FloorAndLamp big_floor(1.0, 0.5, 1.0);
-  EXPECT_EQ(choose_split(big_floor.h, big_floor.link(1.0f), 0.1, 1.0, limits), Split::Receiver);
+  EXPECT_EQ(choose_split(big_floor.h, big_floor.link(1.0f), 0.1,
+                         DecisionScale{Oracle::Standard, 1.0}, limits),
+            Split::Receiver);
   const FloorAndLamp big_lamp(0.5, 1.0, 1.0);
-  EXPECT_EQ(choose_split(big_lamp.h, big_lamp.link(1.0f), 0.1, 1.0, limits), Split::Emitter);
+  EXPECT_EQ(choose_split(big_lamp.h, big_lamp.link(1.0f), 0.1, DecisionScale{Oracle::Standard, 1.0},
+                         limits),
+            Split::Emitter);
+}
+
+TEST(ChooseSplit, NoticeableIsRelativeToTheReceiversRadiance) {
+  // brightness 0.5 x oracle 1 over one JND at the receiver: 0.02 (L_p + 0.2 x 1).
+  FloorAndLamp s(1.0, 1.0, 1.0);
+  const DecisionScale scale{Oracle::Noticeable, 1.0};
+  const RefineLimits limits{1e-6, {}};
+  s.h.element(s.floor()).radiance = Rgb(0.8);  // 0.5 / 0.02 = 25 JND
+  EXPECT_EQ(choose_split(s.h, s.link(1.0f), 24.0, scale, limits), Split::Receiver);
+  EXPECT_EQ(choose_split(s.h, s.link(1.0f), 26.0, scale, limits), Split::None);
+  // The same error on a receiver four times brighter is four times less visible.
+  s.h.element(s.floor()).radiance = Rgb(3.8);
+  EXPECT_EQ(choose_split(s.h, s.link(1.0f), 6.0, scale, limits), Split::Receiver);
+  EXPECT_EQ(choose_split(s.h, s.link(1.0f), 6.5, scale, limits), Split::None);
 }
 
 TEST(ChooseSplit, NothingBelowTheSmallestElement) {
   const FloorAndLamp s(1.0, 0.5, 1.0);
   // The floor's children would be 0.25, the lamp's 0.0625.
-  EXPECT_EQ(choose_split(s.h, s.link(1.0f), 0.1, 1.0, RefineLimits{0.3, {}}), Split::None);
-  EXPECT_EQ(choose_split(s.h, s.link(1.0f), 0.1, 1.0, RefineLimits{0.2, {}}), Split::Receiver);
+  EXPECT_EQ(choose_split(s.h, s.link(1.0f), 0.1, DecisionScale{Oracle::Standard, 1.0},
+                         RefineLimits{0.3, {}}),
+            Split::None);
+  EXPECT_EQ(choose_split(s.h, s.link(1.0f), 0.1, DecisionScale{Oracle::Standard, 1.0},
+                         RefineLimits{0.2, {}}),
+            Split::Receiver);
 }
 
 TEST(SplitLinks, ASplitLinkBecomesFourLinksToTheChildrenInOrder) {

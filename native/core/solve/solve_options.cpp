@@ -15,6 +15,7 @@ std::optional<Oracle> parse_oracle(std::string_view name) {
   if (name == "standard") return Oracle::Standard;
   if (name == "perceptual") return Oracle::Perceptual;
   if (name == "gradient") return Oracle::Gradient;
+  if (name == "noticeable") return Oracle::Noticeable;
   return std::nullopt;
 }
 
@@ -26,6 +27,8 @@ std::string_view oracle_name(Oracle oracle) {
       return "perceptual";
     case Oracle::Gradient:
       return "gradient";
+    case Oracle::Noticeable:
+      return "noticeable";
   }
   return "unknown";
 }

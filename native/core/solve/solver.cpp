@@ -45,6 +45,8 @@ ThresholdRange threshold_range(Oracle oracle) {
       return {1.0, 4e-3};
     case Oracle::Gradient:
       return {1e-1, 2.5e-4};
+    case Oracle::Noticeable:  // just noticeable differences
+      return {40.0, 0.25};
   }
   return {1.0, 1e-4};
 }
@@ -158,8 +160,8 @@ class Solver {
   SceneOccluders occluders_;
   LinkEvaluator evaluator_;
   DirectLight direct_;
-  // Brightness the oracles' thresholds are relative to (refine()).
-  double reference_radiance_ = 0.0;
+  // What the oracles' values are relative to (refine()).
+  DecisionScale decision_scale_;
   RefineLimits limits_;
   const std::size_t roots_;   // elements before any split: every split adds four
   std::size_t memory_limit_;  // bytes of elements and links (SolveOptions::memory_limit)
@@ -332,7 +334,7 @@ void Solver::drop_links_light_cannot_reach() {
 // is, evaluating the new links. Returns whether anything changed.
 bool Solver::refine(double threshold) {
   if (!std::isfinite(threshold)) return false;
-  reference_radiance_ = adaptation_radiance(hierarchy_);
+  decision_scale_ = DecisionScale{options_.oracle, adaptation_radiance(hierarchy_)};
   bool changed = false;
   while (!cancelled() && !budget_hit_ && !out_of_time()) {
     if (over_memory()) {
@@ -340,7 +342,7 @@ bool Solver::refine(double threshold) {
       break;
     }
     const std::vector<Split> decision =
-        choose_splits(hierarchy_, links_, threshold, reference_radiance_, limits_);
+        choose_splits(hierarchy_, links_, threshold, decision_scale_, limits_);
     SplitLinks round = split_links(hierarchy_, links_, decision, limits_);
     budget_hit_ = budget_hit_ || round.budget_hit;
     hand_down_links(hierarchy_, options_.leaf_links, round);
@@ -380,7 +382,7 @@ bool Solver::refine(double threshold) {
 // its children's. Returns whether the light links changed.
 bool Solver::refine_light_links(double threshold) {
   if (light_links_.empty()) return false;
-  if (split_light_receivers(hierarchy_, scene_.lights, light_links_, threshold, reference_radiance_,
+  if (split_light_receivers(hierarchy_, scene_.lights, light_links_, threshold, decision_scale_,
                             limits_))
     budget_hit_ = true;
   std::vector<LightLink> fresh = hand_down_light_links(hierarchy_, light_links_);

@@ -40,6 +40,10 @@ enum class Oracle : std::uint8_t {
   Standard,    // BF: (F_max - F_min) A_p                              (eq. 6)
   Perceptual,  // k max r_ij, from values and tangential slopes        (eqs. 25-28)
   Gradient,    // max |pr(grad F_i) - pr(grad F_j)| A_p                (eqs. 18-20)
+  // The error of the mesh's linear reconstruction (from the same samples as
+  // Perceptual) in just noticeable differences: Weber contrast against the
+  // receiver's radiance, fading for elements smaller than the eye resolves.
+  Noticeable,
 };
 
 // How partly occluded links see their emitter: the exact visible polygon, or
