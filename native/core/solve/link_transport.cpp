@@ -277,8 +277,8 @@ bool finish(const LinkEvaluator& evaluator, Link& link, const LinkEnds& ends, Sa
   }
   timings.oracle += seconds_since(start);
 
-  // The oracle judged the samples' shape; what is gathered also carries the
-  // right total.
+  // What is gathered carries the right total; the oracle judges the samples
+  // as measured (copied above), Noticeable also by how far this moved them.
   const auto conserve_start = Clock::now();
   for (int s = 0; s < ends.ns; ++s) values.value[s] = std::max(0.0, values.value[s]);
   const double before = sample_average(receiver.corner_count, values.value);

@@ -82,7 +82,8 @@ double oracle_reference(Oracle oracle, double adaptation, double receiver_lumina
 
 // The oracle's scale in a scene, so thresholds are relative (DESIGN s3): with
 // reference radiance L_ref and total area A, Standard divides by L_ref A,
-// Perceptual by L_ref, Gradient by L_ref sqrt(A). The geometric part (A, 1,
+// Perceptual by L_ref, Gradient by L_ref sqrt(A) (Noticeable: by one JND at
+// the receiver when deciding, oracle_reference; 1 here). The geometric part (A, 1,
 // sqrt(A)) is applied when a link is made, so links store a dimensionless value.
 double oracle_scale(Oracle oracle, double reference_radiance, double total_area);
 double oracle_geometric_scale(Oracle oracle, double total_area);
