@@ -46,7 +46,7 @@ ThresholdRange threshold_range(Oracle oracle) {
     case Oracle::Gradient:
       return {1e-1, 2.5e-4};
     case Oracle::Noticeable:  // just noticeable differences
-      return {40.0, 0.25};
+      return {10.0, 0.25};
   }
   return {1.0, 1e-4};
 }
