@@ -62,8 +62,10 @@ def oracle_curves(st, metric, cost):
 
 
 def equal_error_table(studies, metric):
-    """Per scene and error level: each oracle's leaves and seconds to reach it, each
-    other oracle's ratio to the standard oracle's, and each oracle's exposure error
+    """Per scene and error level (three inside the overlap of the standard
+    oracle's curve and each other oracle's): each oracle's leaves and seconds to
+    reach it, each other oracle's ratio to the standard oracle's (where both are
+    interpolated, not bounds), and each oracle's exposure error
     there (interpolated along its curve at the leaves it needs: the solutions
     compared are equally good by `metric`, not necessarily equally bright).
     Returns the table's lines and, per scene, one {oracle: (leaves ratio, time
@@ -80,7 +82,11 @@ def equal_error_table(studies, metric):
         by_leaves = oracle_curves(st, metric, "leaves")
         by_time = oracle_curves(st, metric, "seconds")
         exposure = oracle_curves(st, "exposure_cycles", "leaves")
-        levels = curves.common_levels(list(by_leaves.values()))
+        # Each oracle against the standard oracle where their two curves overlap
+        # (an oracle whose coarsest solution is finer than another's finest
+        # still meets the standard oracle's curve).
+        levels = sorted({lv for o in others
+                         for lv in curves.common_levels([by_leaves["standard"], by_leaves[o]])}, reverse=True)
         if not levels:
             lines.append("| %s | curves do not overlap |%s" % (st.name, " |" * (len(head) - 2)))
             continue
@@ -200,7 +206,8 @@ def write(path, studies, settings, plots, figures, seconds):
             "beside them: a solution can score well and still be too bright (light leaking past contacts, "
             "issue 12) or too dark (energy lost per bounce in closed rooms).", ""]
     out += ["## Elements and time at equal error", "",
-            "For each scene, three error levels inside the range all oracles reach; the leaves and seconds each "
+            "For each scene, three error levels inside the overlap of each oracle's curve with the standard "
+            "oracle's (the rows of all pairs, finest last); the leaves and seconds each "
             "oracle needs to get at least that good (lower envelope of its curve, log-log interpolation), and "
             "each oracle's exposure error there (interpolated along its solves in log leaves): equal error does "
             "not mean equal brightness. The source claims perceptual/standard of about 0.5 for both; issue 16 asks "

@@ -61,7 +61,6 @@ class LitRoomBalance(unittest.TestCase):
         emitted = math.pi * LAMP_RADIANCE * 0.36
         for rho in (0.5, 0.9, 0.99):
             for oracle in ORACLES:
-                elements = []
                 for quality in QUALITIES:
                     with self.subTest(rho=rho, oracle=oracle, quality=quality):
                         b = lit_room(rho)
@@ -71,11 +70,7 @@ class LitRoomBalance(unittest.TestCase):
                               % (rho, oracle, quality, ratio[0], result.stats["elements"],
                                  result.stats["iterations"]), flush=True)
                         np.testing.assert_allclose(ratio, 1.0, rtol=tolerance(rho))
-                        elements.append(result.stats["elements"])
-                # The balance is tested with refinement: from quality 0.5 every oracle refines
-                # this room (at 0.3, 8.7 JND, Noticeable leaves the white room's even light unrefined).
-                with self.subTest(rho=rho, oracle=oracle):
-                    self.assertTrue(all(n > 30 for q, n in zip(QUALITIES, elements) if q >= 0.5), elements)
+                        self.assertGreater(result.stats["elements"], 30)  # refined: the balance is tested with refinement
 
     def test_white_room_converges_in_a_few_dozen_iterations(self):
         # Jacobi alone gains a factor rho per iteration: about 900 iterations
