@@ -35,7 +35,7 @@ def quality_meaning(oracle, threshold):
         return "Light spread below %s" % _number(threshold)
     if oracle == 'GRADIENT':
         # Change of slope times area over the scene's size.
-        return "Slope changes below %s" % _number(threshold)
+        return "Slope change below %s" % _number(threshold)
     return ""
 
 

@@ -374,13 +374,12 @@ class PanelTest(unittest.TestCase):
                 texts = []
                 for quality in (0.2, 0.8):
                     settings.quality = quality
+                    threshold = rad.quality_threshold(oracle.lower(), quality)
+                    texts.append(quality_meaning.quality_meaning(oracle, threshold))
                     with self.subTest(oracle=oracle, quality=quality):
                         layout = self.draw(ui.RENDER_PT_radiosity_quality)
                         self.assert_fits(layout)
-                        threshold = rad.quality_threshold(oracle.lower(), quality)
-                        meaning = quality_meaning.quality_meaning(oracle, threshold)
-                        self.assertIn(meaning, layout.record["labels"])
-                        texts.append(meaning)
+                        self.assertIn(texts[-1], layout.record["labels"])
                 self.assertNotEqual(texts[0], texts[1], oracle)
             settings.oracle, settings.quality = 'NOTICEABLE', 0.5
             jnd = rad.quality_threshold("noticeable", 0.5)
