@@ -1,7 +1,7 @@
 """report.md of the study: what was run, the references and their noise, the
 elements and time each oracle needs at equal error (interpolated along its
-curve, curves.py) with each oracle's ratio to the standard oracle's, the least-squares table of
-Section 7.3.4, and the Cycles bake comparison. Every table states the signed
+curve, curves.py) with each oracle's ratio to the standard oracle's, the
+least-squares table of Section 7.3.4, and the Cycles bake comparison. Every table states the signed
 exposure error against the path-traced reference (mean linear luminance,
 emitter pixels left out) beside the error metrics, which do not see it: the
 DoG filter removes brightness, RMS on display brightness dilutes it. Numbers

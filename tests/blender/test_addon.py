@@ -383,7 +383,8 @@ class PanelTest(unittest.TestCase):
                 self.assertNotEqual(texts[0], texts[1], oracle)
             settings.oracle, settings.quality = 'NOTICEABLE', 0.5
             jnd = rad.quality_threshold("noticeable", 0.5)
-            self.assertIn("Differences below %.2g JND" % jnd, self.draw(ui.RENDER_PT_radiosity_quality).record["labels"])
+            self.assertIn("Differences below %.2g JND" % jnd,
+                          self.draw(ui.RENDER_PT_radiosity_quality).record["labels"])
             settings.quality = 0.0
             self.assertIn("No refinement: the coarsest lighting",
                           self.draw(ui.RENDER_PT_radiosity_quality).record["labels"])
