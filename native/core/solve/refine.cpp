@@ -80,9 +80,11 @@ Split choose_split(const Hierarchy& hierarchy, const Link& link, double threshol
   // Noticeable judges what the receiver's samples show. A light's
   // radiance is its uniform emission, so splitting it changes no light the
   // link carries, only how the same error is shared out among four links:
-  // links from lights split their receiver first (from reflecting surfaces,
-  // whose radiance varies, the larger end, as the others).
-  const bool from_light = luminance(hierarchy.emission(q)) >= 0.5 * luminance(q.radiance);
+  // links from lights (at least 90 % of their radiance emitted) split their
+  // receiver first. From reflecting surfaces, whose radiance varies, the
+  // larger end, as the others (with half, the furnace's walls counted as
+  // lights and came out 1.0e-3 off next to their edges).
+  const bool from_light = luminance(hierarchy.emission(q)) >= 0.9 * luminance(q.radiance);
   const bool receiver_first =
       p.area >= q.area || (scale.oracle == Oracle::Noticeable && from_light &&
                            limits.can_split(hierarchy, link.receiver));
