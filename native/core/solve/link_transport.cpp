@@ -281,7 +281,9 @@ bool finish(const LinkEvaluator& evaluator, Link& link, const LinkEnds& ends, Sa
   // as measured (copied above), Noticeable also by how far this moved them.
   const auto conserve_start = Clock::now();
   for (int s = 0; s < ends.ns; ++s) values.value[s] = std::max(0.0, values.value[s]);
-  const double before = sample_average(receiver.corner_count, values.value);
+  const bool judges_correction = evaluator.oracle == Oracle::Noticeable;
+  const double before =
+      judges_correction ? sample_average(receiver.corner_count, values.value) : 0.0;
   const bool grid = !unoccluded && evaluator.visibility == VisibilityMode::Exact &&
                     hierarchy.samples_inset(receiver);
   const double shadow_contrast =
@@ -299,7 +301,9 @@ bool finish(const LinkEvaluator& evaluator, Link& link, const LinkEnds& ends, Sa
                       hierarchy.diameter(receiver),
                       resolvable_size(hierarchy.scene().total_area),
                       used - with_tangents,
-                      std::abs(sample_average(receiver.corner_count, values.value) - before),
+                      judges_correction
+                          ? std::abs(sample_average(receiver.corner_count, values.value) - before)
+                          : 0.0,
                       shadow_contrast};
   link.oracle = with_tangents >= 1 && used >= 2
                     ? static_cast<float>(oracle_geometry(evaluator.oracle, samples) /
