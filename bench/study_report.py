@@ -106,6 +106,54 @@ def equal_error_table(studies, metric):
     return lines, summary
 
 
+def targets_table(studies, summaries):
+    """Per scene, study_config.TARGET_ORACLE against study_config.TARGETS: the
+    median and worst leaves and time ratios to the standard oracle at equal DoG
+    error (refined reference; the path trace's medians beside them), the levels
+    where even its coarsest solve has more leaves than the standard oracle needs
+    (no ratio there, but more leaves all the same), its cost per element over
+    the standard oracle's, its exposure range, and which targets it misses."""
+    oracle, t = study_config.TARGET_ORACLE, study_config.TARGETS
+    lines = ["| scene | leaves ratio median (worst) | time ratio median (worst) | vs Cycles: leaves, time "
+             "| levels its coarsest solve is larger | b ratio | exposure | not met |",
+             "|---|---|---|---|---|---|---|---|"]
+    for st in studies:
+        def ratios(metric, k):
+            return [lv[oracle][k] for lv in summaries[metric].get(st.name, []) if lv[oracle][k] is not None]
+        leaves, time = ratios("dog_refined", 0), ratios("dog_refined", 1)
+        median = lambda v: float(np.median(v)) if v else None
+        by_leaves = oracle_curves(st, "dog_refined", "leaves")
+        # The levels of the equal-error table (every oracle's overlap with the standard's).
+        levels = sorted({lv for o in study_config.ORACLES if o != "standard"
+                         for lv in curves.common_levels([by_leaves["standard"], by_leaves[o]])})
+        larger = 0
+        for level in levels:
+            own, std = curves.cost_to_reach(*by_leaves[oracle], level), curves.cost_to_reach(*by_leaves["standard"], level)
+            larger += own[0] == "<=" and std[0] == "=" and own[1] > std[1]
+        fits = {o: curves.least_squares(*[[r[k] for r in st.rows if r["method"] == "radiosity" and r["oracle"] == o]
+                                           for k in ("leaves", "seconds")]) for o in ("standard", oracle)}
+        b_ratio = ratio(fits[oracle][1], fits["standard"][1])
+        rows = [r for r in st.rows if r["method"] == "radiosity" and r["oracle"] == oracle]
+        worst_exposure = max((abs(r["exposure_cycles"]) for r in rows), default=None)
+        missed = []
+        if median(leaves) is None or median(leaves) > t["leaves_ratio"]:
+            missed.append("leaves")
+        if median(time) is None or median(time) > t["time_ratio"]:
+            missed.append("time")
+        if (leaves and max(leaves) > t["worst_leaves_ratio"]) or larger:
+            missed.append("more leaves at some level")
+        if b_ratio is None or not b_ratio <= t["cost_per_element_ratio"]:
+            missed.append("cost per element")
+        if worst_exposure is None or worst_exposure > t["exposure"]:
+            missed.append("exposure")
+        lines.append("| %s | %s (%s) | %s (%s) | %s, %s | %d of %d | %s | %s | %s |" % (
+            st.name, fmt(median(leaves)), fmt(max(leaves) if leaves else None), fmt(median(time)),
+            fmt(max(time) if time else None), fmt(median(ratios("dog_cycles", 0))),
+            fmt(median(ratios("dog_cycles", 1))), larger, len(levels), fmt(b_ratio), exposure_range(rows),
+            ", ".join(missed) or "none"))
+    return lines
+
+
 def regression_table(studies):
     lines = ["| scene | oracle | n | a (s) | b (s per element) | r | time at 5000 leaves (s) | exposure errors |",
              "|---|---|---|---|---|---|---|---|"]
@@ -237,6 +285,16 @@ def write(path, studies, settings, plots, figures, seconds):
         cells += [exposure_range([r for r in st.rows if r["method"] == "radiosity" and r["oracle"] == o])
                   for o in study_config.ORACLES]
         out.append("| " + " | ".join(cells) + " |")
+    t = study_config.TARGETS
+    out += ["", "### Targets of %s (issue 16)" % study_config.TARGET_ORACLE, "",
+            "At equal DoG error: at most %s of the standard oracle's leaves and %s of its time (median over the "
+            "levels), never more leaves at any level, cost per element (b below) at most %s times the standard "
+            "oracle's, every solve's exposure within %s of the path trace. 'Levels its coarsest solve is larger' "
+            "counts the levels of its overlap with the standard oracle's curve where even its coarsest solve has "
+            "more leaves than the standard oracle needs there." % (fmt(t["leaves_ratio"]), fmt(t["time_ratio"]),
+                                                                  fmt(t["cost_per_element_ratio"]),
+                                                                  pct(t["exposure"]).lstrip("+")), ""]
+    out += targets_table(studies, summaries)
     out += ["", "## Time against elements (Section 7.3.4: time = a + b x leaves)", ""] + regression_table(studies)
     out += ["", "## Equal-size comparison (Sections 7.4-7.5.2)", "",
             "| scene | oracle | leaves | DoG vs refined | RMS vs refined | DoG vs Cycles | RMS vs Cycles "

@@ -82,6 +82,39 @@ TEST(ChooseSplit, NoticeableIsRelativeToTheReceiversRadiance) {
   EXPECT_EQ(choose_split(s.h, s.link(1.0f), 6.5, scale, limits), Split::None);
 }
 
+TEST(ChooseSplit, NoticeableSplitsAnUnevenEmitterItsReceiverSeesEvenly) {
+  // A reflecting square (rho 0.5) above the floor, already split, whose link
+  // shows no error at the floor's samples (oracle 0, F = 0.2 at each).
+  test::Arrays a;
+  a.square(dvec3(0.0), 1.0, true, 0.5, 0.0);
+  a.square(dvec3(0.0, 0.0, 1.0), 1.0, false, 0.5, 0.0);
+  a.square(dvec3(5.0, 0.0, 1.0), 0.1, false, 0.0, 1.0);  // a scene needs a light
+  const Scene scene = a.scene();
+  Hierarchy h(scene);
+  const std::int32_t floor = h.root(0, 0), ceiling = h.root(1, 0);
+  const std::int32_t first = h.subdivide(ceiling);
+  h.element(floor).radiance = Rgb(0.8);  // one JND there: 0.02 (0.8 + 0.2 x 1)
+  Link link;
+  link.receiver = floor;
+  link.emitter = ceiling;
+  link.form_factor.fill(0.2f);
+  const DecisionScale noticeable{Oracle::Noticeable, 1.0};
+  const RefineLimits limits{1e-6, {}};
+  const auto parts = [&](double a0, double a1, double a2, double a3) {
+    const double r[4] = {a0, a1, a2, a3};
+    for (int c = 0; c < 4; ++c) h.element(first + c).radiance = Rgb(r[c]);
+    h.element(ceiling).radiance = Rgb(0.25 * (a0 + a1 + a2 + a3));
+  };
+  // Parts 0.2 to 0.6: 0.5 x 0.2 x 0.4 = 0.04, two JND.
+  parts(0.2, 0.6, 0.4, 0.4);
+  EXPECT_EQ(choose_split(h, link, 1.5, noticeable, limits), Split::Emitter);
+  EXPECT_EQ(choose_split(h, link, 2.5, noticeable, limits), Split::None);
+  EXPECT_EQ(choose_split(h, link, 1.5, DecisionScale{Oracle::Standard, 1.0}, limits), Split::None);
+  // An even emitter sends the right radiance whatever part the receiver sees.
+  parts(0.4, 0.4, 0.4, 0.4);
+  EXPECT_EQ(choose_split(h, link, 1e-3, noticeable, limits), Split::None);
+}
+
 TEST(ChooseSplit, NothingBelowTheSmallestElement) {
   const FloorAndLamp s(1.0, 0.5, 1.0);
   // The floor's children would be 0.25, the lamp's 0.0625.
