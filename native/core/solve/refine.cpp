@@ -108,10 +108,11 @@ Split choose_split(const Hierarchy& hierarchy, const Link& link, double threshol
   const bool from_light = is_light(hierarchy, q);
   if (!(brightness / scale.at(p) * link.oracle > threshold)) {
     // Noticeable: the receiver's samples show no error, but the emitter's
-    // average may be the wrong radiance for this receiver (a wall's top band
-    // under a floor lit unevenly came out 2.7 % dark in the Cornell box, the
-    // same at any mesh density, until the floor's link was split). A split
-    // emitter is already subdivided: this costs links, not elements.
+    // average may be the wrong radiance for this receiver (the Cornell box's
+    // wall tops came out 2.7 % dark at any mesh density, sent the average of
+    // the ceiling beside the light, which is lit unevenly, until that link
+    // was split). A split emitter is already subdivided: this costs links,
+    // not elements.
     if (scale.oracle == Oracle::Noticeable && !from_light &&
         emitter_side_error(hierarchy, link) / scale.at(p) > threshold)
       return Split::Emitter;
