@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <numbers>
+#include <span>
 
 #include "core/geometry/random.h"
 
@@ -42,25 +43,44 @@ bool flat_pair_apart(const ClusterNode& rx, const ClusterNode& ry) {
   return -ry.height_lo <= rx.height_lo + tolerance;
 }
 
+// Each side of the tree (in the tree's order) as the walk's rays sample it:
+// its face and its corners, a quad as two triangles with the first one's share
+// of the area. Made once per walk rather than read through the hierarchy for
+// each of the 32 points of every cluster link's rays.
+struct SideSample {
+  dvec3 c[4];
+  double first = 0.0, total = 0.0;  // the first triangle's area and both (times 2)
+  std::uint32_t face = 0;
+  bool quad = false;
+};
+
+std::vector<SideSample> side_samples(const ClusterTree& tree, const Hierarchy& hierarchy) {
+  std::vector<SideSample> out(tree.sides().size());
+  for (size_t i = 0; i < out.size(); ++i) {
+    const Element& e = hierarchy.element(tree.sides()[i]);
+    SideSample& s = out[i];
+    s.face = hierarchy.patch_of(e).surface;
+    s.quad = hierarchy.corners(e, s.c) == 4;
+    if (s.quad) {
+      s.first = glm::length(glm::cross(s.c[1] - s.c[0], s.c[2] - s.c[0]));
+      s.total = s.first + glm::length(glm::cross(s.c[2] - s.c[0], s.c[3] - s.c[0]));
+    }
+  }
+  return out;
+}
+
 // A point uniformly distributed over the node's sides (area-weighted).
-dvec3 random_point(const ClusterTree& tree, const Hierarchy& hierarchy, const ClusterNode& node,
-                   SplitMix64& random, std::uint32_t& face) {
+dvec3 random_point(const ClusterTree& tree, std::span<const SideSample> sides,
+                   const ClusterNode& node, SplitMix64& random, std::uint32_t& face) {
   const auto& prefix = tree.area_prefix();
   const double target = prefix[node.first] +
                         random.uniform() * (prefix[node.first + node.count] - prefix[node.first]);
   const auto it = std::upper_bound(prefix.begin() + node.first + 1,
                                    prefix.begin() + node.first + node.count, target);
-  const auto index = static_cast<size_t>(it - prefix.begin()) - 1;
-  const Element& e = hierarchy.element(tree.sides()[index]);
-  face = hierarchy.patch_of(e).surface;
-  dvec3 c[4];
-  const int n = hierarchy.corners(e, c);
-  dvec3 a = c[0], b = c[1], t = c[2];
-  if (n == 4) {
-    const double first = glm::length(glm::cross(c[1] - c[0], c[2] - c[0]));
-    const double second = glm::length(glm::cross(c[2] - c[0], c[3] - c[0]));
-    if (random.uniform() * (first + second) >= first) b = c[2], t = c[3];
-  }
+  const SideSample& side = sides[static_cast<size_t>(it - prefix.begin()) - 1];
+  face = side.face;
+  dvec3 a = side.c[0], b = side.c[1], t = side.c[2];
+  if (side.quad && random.uniform() * side.total >= side.first) b = side.c[2], t = side.c[3];
   const double s = std::sqrt(random.uniform()), r = random.uniform();
   return (1 - s) * a + s * (1 - r) * b + s * r * t;
 }
@@ -80,22 +100,23 @@ struct PairOutcome {
 
 // Of `rays` shadow rays between random points of the two clusters' sides, how
 // many pass. Seeded by the pair: the answer does not depend on threads.
-int passing_rays(const ClusterTree& tree, const Hierarchy& hierarchy, const RayScene& scene,
+int passing_rays(const ClusterTree& tree, std::span<const SideSample> sides, const RayScene& scene,
                  std::int32_t receiver, std::int32_t emitter, int rays) {
   SplitMix64 random{(static_cast<std::uint64_t>(static_cast<std::uint32_t>(receiver)) << 32) |
                     static_cast<std::uint32_t>(emitter)};
   int passed = 0;
   for (int k = 0; k < rays; ++k) {
     std::uint32_t from_face = 0, to_face = 0;
-    const dvec3 from = random_point(tree, hierarchy, tree.node(emitter), random, from_face);
-    const dvec3 to = random_point(tree, hierarchy, tree.node(receiver), random, to_face);
+    const dvec3 from = random_point(tree, sides, tree.node(emitter), random, from_face);
+    const dvec3 to = random_point(tree, sides, tree.node(receiver), random, to_face);
     passed += scene.occluded(from, to, from_face, to_face) ? 0 : 1;
   }
   return passed;
 }
 
-PairOutcome classify(const ClusterTree& tree, const Hierarchy& hierarchy, const RayScene& scene,
-                     double separation, int rays, std::int32_t x, std::int32_t y) {
+PairOutcome classify(const ClusterTree& tree, const Hierarchy& hierarchy,
+                     std::span<const SideSample> sides, const RayScene& scene, double separation,
+                     int rays, std::int32_t x, std::int32_t y) {
   PairOutcome out;
   const ClusterNode& rx = tree.node(x);
   const ClusterNode& ry = tree.node(y);
@@ -126,7 +147,7 @@ PairOutcome classify(const ClusterTree& tree, const Hierarchy& hierarchy, const 
       // is then that side's own (a receiving cluster would give the light of
       // its centre to every side, off by 2 r / d).
       if (!rx.is_leaf()) return split(PairOutcome::SplitReceiver);
-      const int passed = passing_rays(tree, hierarchy, scene, x, y, rays);
+      const int passed = passing_rays(tree, sides, scene, x, y, rays);
       if (passed == 0) return out;
       out.kind = PairOutcome::ClusterPair;
       out.link.receiver = x;
@@ -200,8 +221,9 @@ InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy,
   InitialLinks links;
   if (tree.root() == kNone) return links;
   using Pair = std::pair<std::int32_t, std::int32_t>;
+  const std::vector<SideSample> sides = side_samples(tree, hierarchy);
   const auto classify_pair = [&](const Pair& p) {
-    return classify(tree, hierarchy, scene, separation, rays, p.first, p.second);
+    return classify(tree, hierarchy, sides, scene, separation, rays, p.first, p.second);
   };
   // Breadth first until there are enough pairs to share between threads, then
   // each pair's subtree depth first (memory stays that of one path per

@@ -87,6 +87,10 @@ LinkEnds link_ends(const Hierarchy& h, const Element& receiver, const Element& e
 struct SampleValues {
   double value[kMaxSamples] = {};
   dvec3 grad[kMaxSamples] = {};
+  // The unoccluded F where the visibility computation gave it (-1: not known),
+  // so the energy correction need not compute it again.
+  double open[kMaxSamples];
+  SampleValues() { std::fill(std::begin(open), std::end(open), -1.0); }
 };
 
 std::vector<Triangle>& gather_candidates(const OccluderScene& scene, const ShaftCulling& culling) {
@@ -138,8 +142,9 @@ double grid_visible_share(const LinkEnds& ends, int corner_count,
   for (int i = 0; i < kGrid; ++i) {
     for (int j = 0; j < kGrid; ++j) {
       const dvec3 x = grid_point(c, corner_count, i, j, kGrid);
-      visible += visible_form_factor(x, ends.n, ends.emitter_polygon(), occluders);
-      open += form_factor(x, ends.n, ends.emitter_polygon());
+      double unoccluded = 0.0;
+      visible += visible_form_factor(x, ends.n, ends.emitter_polygon(), occluders, &unoccluded);
+      open += unoccluded;
     }
   }
   return open > 0.0 ? visible / open : -1.0;
@@ -162,8 +167,10 @@ double conserve_energy(const Element& receiver, const LinkEnds& ends, bool unocc
   double visible[kMaxSamples] = {};
   double hidden_most = 0.0, hidden_least = std::numeric_limits<double>::infinity();
   for (int s = 0; s < ends.ns; ++s) {
-    const double f =
-        unoccluded ? values.value[s] : form_factor(ends.x[s], ends.n, ends.emitter_polygon());
+    const double f = unoccluded ? values.value[s]
+                     : values.open[s] >= 0.0
+                         ? values.open[s]
+                         : form_factor(ends.x[s], ends.n, ends.emitter_polygon());
     open[static_cast<size_t>(s)] = Rgb(f);
     in_front[static_cast<size_t>(s)] = Rgb(f > 0.0 ? 1.0 : 0.0);
     visible[s] = f > 0.0 ? std::clamp(values.value[s] / f, 0.0, 1.0) : 0.0;
@@ -365,9 +372,11 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo)
       ++timings.samples_occluded;
       // The standard oracle reads no gradient: F alone is cheaper.
       f = oracle_needs_gradient(oracle)
-              ? visible_form_factor_gradient(x, ends.n, emitter_polygon, candidates)
-              : FormFactorGradient{visible_form_factor(x, ends.n, emitter_polygon, candidates),
-                                   dvec3(0.0)};
+              ? visible_form_factor_gradient(x, ends.n, emitter_polygon, candidates,
+                                             &values.open[s])
+              : FormFactorGradient{
+                    visible_form_factor(x, ends.n, emitter_polygon, candidates, &values.open[s]),
+                    dvec3(0.0)};
     } else {
       // Rays per sample vary their seed with the sample, so neighbours do not
       // share the same stratification pattern.
@@ -378,8 +387,9 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo)
       f = culling.truncated
               ? sampled_form_factor_gradient(x, ends.n, emitter_polygon, *occluders.rays, options,
                                              hierarchy.patch_of(receiver).surface,
-                                             hierarchy.patch_of(emitter).surface)
-              : sampled_form_factor_gradient(x, ends.n, emitter_polygon, candidates, options);
+                                             hierarchy.patch_of(emitter).surface, &values.open[s])
+              : sampled_form_factor_gradient(x, ends.n, emitter_polygon, candidates, options,
+                                             &values.open[s]);
     }
     if (shared && !known) memo->add(vertex, f);
     values.value[s] = f.value;
@@ -432,6 +442,7 @@ void LinkEvaluator::evaluate_emitter_siblings(std::span<Link> links, LinkTimings
   const LinkEnds& shared = ends[0];  // the receiver's samples are the same for all
   for (int s = 0; s < shared.ns; ++s) {
     std::array<FormFactorGradient, 4> f;
+    std::array<double, 4> open{-1.0, -1.0, -1.0, -1.0};
     if (culling.visibility == ShaftVisibility::clear) {
       timings.samples_clear += facing;
       for (size_t k = 0; k < facing; ++k) f[k] = unoccluded(*this, shared.x[s], shared.n, parts[k]);
@@ -441,11 +452,12 @@ void LinkEvaluator::evaluate_emitter_siblings(std::span<Link> links, LinkTimings
       visible_form_factor_gradient_parts(
           shared.x[s], shared.n, parent_polygon,
           std::span<const std::span<const dvec3>>(parts.data(), facing), candidates,
-          std::span<FormFactorGradient>(f.data(), facing));
+          std::span<FormFactorGradient>(f.data(), facing), std::span<double>(open.data(), facing));
     }
     for (size_t k = 0; k < facing; ++k) {
       values[k].value[s] = f[k].value;
       values[k].grad[s] = f[k].gradient;
+      values[k].open[s] = open[k];
     }
   }
   timings.form_factors += seconds_since(start);

@@ -8,14 +8,35 @@
 
 namespace radiosity {
 
-EmitterSamples sample_emitter(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter,
-                              const SampledVisibilityOptions& options) {
-  EmitterSamples out;
+namespace {
+
+// Per-thread scratch of the functions below: a link's samples call them
+// hundreds of thousands of times in a large scene, where allocating their
+// buffers each time cost a tenth of the solve.
+struct Scratch {
+  EmitterSamples samples;
+  std::vector<double> cumulative;
+  std::vector<std::uint8_t> blocked, hit;
+  std::vector<dvec3> targets;
+  std::vector<std::size_t> index;
+};
+
+// Not inlined: see thread_workspace() in visible_polygon.cpp.
+[[gnu::noinline]] Scratch& thread_scratch() {
+  thread_local Scratch scratch;
+  return scratch;
+}
+
+void sample_emitter_into(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter,
+                         const SampledVisibilityOptions& options, std::vector<double>& cumulative,
+                         EmitterSamples& out) {
+  out.points.clear();
+  out.weights.clear();
   const int count = std::max(1, options.rays);
-  if (emitter.size() < 3) return out;
+  if (emitter.size() < 3) return;
   // Fan of triangles from v0, chosen by the first parameter in proportion to area.
   const std::size_t fan = emitter.size() - 2;
-  std::vector<double> cumulative(fan);
+  cumulative.resize(fan);
   dvec3 normal(0.0);
   double area = 0.0;
   for (std::size_t i = 0; i < fan; ++i) {
@@ -24,7 +45,7 @@ EmitterSamples sample_emitter(const dvec3& r, const dvec3& n, std::span<const dv
     area += 0.5 * glm::length(c);
     cumulative[i] = area;
   }
-  if (!(area > 0.0)) return out;
+  if (!(area > 0.0)) return;
   normal = glm::normalize(normal);
 
   // A (0,2)-sequence (the first two dimensions of Sobol's sequence) with a random
@@ -69,6 +90,15 @@ EmitterSamples sample_emitter(const dvec3& r, const dvec3& n, std::span<const dv
     out.points.push_back(p);
     out.weights.push_back(cos_r > 0.0 && cos_e > 0.0 && d2 > 0.0 ? cos_r * cos_e / (d2 * d2) : 0.0);
   }
+}
+
+}  // namespace
+
+EmitterSamples sample_emitter(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter,
+                              const SampledVisibilityOptions& options) {
+  EmitterSamples out;
+  std::vector<double> cumulative;
+  sample_emitter_into(r, n, emitter, options, cumulative, out);
   return out;
 }
 
@@ -83,16 +113,21 @@ double visible_fraction(const EmitterSamples& samples, std::span<const std::uint
 
 double visible_fraction(const RayScene& scene, const dvec3& r, const EmitterSamples& samples,
                         std::uint32_t receiver_face, std::uint32_t emitter_face) {
-  std::vector<std::uint8_t> blocked(samples.points.size(), 0);
+  Scratch& scratch = thread_scratch();
+  std::vector<std::uint8_t>& blocked = scratch.blocked;
+  blocked.assign(samples.points.size(), 0);
   // Rays towards points with zero weight change nothing: do not cast them.
-  std::vector<dvec3> targets;
-  std::vector<std::size_t> index;
+  std::vector<dvec3>& targets = scratch.targets;
+  std::vector<std::size_t>& index = scratch.index;
+  targets.clear();
+  index.clear();
   for (std::size_t i = 0; i < samples.points.size(); ++i)
     if (samples.weights[i] > 0.0) {
       targets.push_back(samples.points[i]);
       index.push_back(i);
     }
-  std::vector<std::uint8_t> hit(targets.size(), 0);
+  std::vector<std::uint8_t>& hit = scratch.hit;
+  hit.assign(targets.size(), 0);
   scene.occluded(r, targets, hit, receiver_face, emitter_face);
   for (std::size_t j = 0; j < index.size(); ++j) blocked[index[j]] = hit[j];
   return visible_fraction(samples, blocked);
@@ -128,9 +163,12 @@ struct CandidatesFromPoint {
   std::vector<double> qx, qy, qz;                    // (r - v0) x e1
   std::vector<double> tq;                            // e2 . q: t times det
 
-  CandidatesFromPoint(std::span<const Triangle> candidates, const dvec3& r) {
-    for (auto* v : {&e1x, &e1y, &e1z, &e2x, &e2y, &e2z, &sx, &sy, &sz, &qx, &qy, &qz, &tq})
+  // Lays out `candidates` as seen from r, reusing the arrays' storage.
+  void reset(std::span<const Triangle> candidates, const dvec3& r) {
+    for (auto* v : {&e1x, &e1y, &e1z, &e2x, &e2y, &e2z, &sx, &sy, &sz, &qx, &qy, &qz, &tq}) {
+      v->clear();
       v->reserve(candidates.size());
+    }
     for (const Triangle& t : candidates) {
       const dvec3 e1 = t.v[1] - t.v[0], e2 = t.v[2] - t.v[0], s = r - t.v[0];
       const dvec3 q = glm::cross(s, e1);
@@ -188,9 +226,12 @@ struct CandidatesFromPoint {
 
 double visible_fraction(std::span<const Triangle> candidates, const dvec3& r,
                         const EmitterSamples& samples) {
-  std::vector<std::uint8_t> blocked(samples.points.size(), 0);
+  thread_local CandidatesFromPoint from;
+  Scratch& scratch = thread_scratch();
+  std::vector<std::uint8_t>& blocked = scratch.blocked;
+  blocked.assign(samples.points.size(), 0);
   if (!candidates.empty()) {
-    const CandidatesFromPoint from(candidates, r);
+    from.reset(candidates, r);
     for (std::size_t i = 0; i < samples.points.size(); ++i)
       if (samples.weights[i] > 0.0) blocked[i] = from.blocked(samples.points[i] - r);
   }
@@ -202,22 +243,27 @@ FormFactorGradient sampled_form_factor_gradient(const dvec3& r, const dvec3& n,
                                                 const RayScene& scene,
                                                 const SampledVisibilityOptions& options,
                                                 std::uint32_t receiver_face,
-                                                std::uint32_t emitter_face) {
+                                                std::uint32_t emitter_face, double* open) {
   FormFactorGradient fg = form_factor_gradient(r, n, emitter);
+  if (open) *open = fg.value;
   if (fg.value <= 0.0) return fg;
-  const EmitterSamples samples = sample_emitter(r, n, emitter, options);
-  const double fraction = visible_fraction(scene, r, samples, receiver_face, emitter_face);
+  Scratch& scratch = thread_scratch();
+  sample_emitter_into(r, n, emitter, options, scratch.cumulative, scratch.samples);
+  const double fraction = visible_fraction(scene, r, scratch.samples, receiver_face, emitter_face);
   return {fraction * fg.value, fraction * fg.gradient};
 }
 
 FormFactorGradient sampled_form_factor_gradient(const dvec3& r, const dvec3& n,
                                                 std::span<const dvec3> emitter,
                                                 std::span<const Triangle> candidates,
-                                                const SampledVisibilityOptions& options) {
+                                                const SampledVisibilityOptions& options,
+                                                double* open) {
   FormFactorGradient fg = form_factor_gradient(r, n, emitter);
+  if (open) *open = fg.value;
   if (fg.value <= 0.0 || candidates.empty()) return fg;
-  const EmitterSamples samples = sample_emitter(r, n, emitter, options);
-  const double fraction = visible_fraction(candidates, r, samples);
+  Scratch& scratch = thread_scratch();
+  sample_emitter_into(r, n, emitter, options, scratch.cumulative, scratch.samples);
+  const double fraction = visible_fraction(candidates, r, scratch.samples);
   return {fraction * fg.value, fraction * fg.gradient};
 }
 

@@ -52,16 +52,17 @@ double visible_fraction(std::span<const Triangle> candidates, const dvec3& r,
 // Segment (a, b) blocked by triangle t (Moller-Trumbore, open segment).
 bool segment_hits_triangle(const dvec3& a, const dvec3& b, const Triangle& t);
 
-FormFactorGradient sampled_form_factor_gradient(const dvec3& r, const dvec3& n,
-                                                std::span<const dvec3> emitter,
-                                                const RayScene& scene,
-                                                const SampledVisibilityOptions& options,
-                                                std::uint32_t receiver_face = kNoFace,
-                                                std::uint32_t emitter_face = kNoFace);
+// The unoccluded F and gradient times the visible fraction; `open`, if given,
+// receives the unoccluded F.
+FormFactorGradient sampled_form_factor_gradient(
+    const dvec3& r, const dvec3& n, std::span<const dvec3> emitter, const RayScene& scene,
+    const SampledVisibilityOptions& options, std::uint32_t receiver_face = kNoFace,
+    std::uint32_t emitter_face = kNoFace, double* open = nullptr);
 
 FormFactorGradient sampled_form_factor_gradient(const dvec3& r, const dvec3& n,
                                                 std::span<const dvec3> emitter,
                                                 std::span<const Triangle> candidates,
-                                                const SampledVisibilityOptions& options);
+                                                const SampledVisibilityOptions& options,
+                                                double* open = nullptr);
 
 }  // namespace radiosity

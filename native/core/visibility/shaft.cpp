@@ -242,6 +242,7 @@ Shaft make_shaft(std::span<const dvec3> receiver, std::span<const dvec3> emitter
         for (const dvec3& p : points) {
           const double d = glm::dot(n, p - points[i]);
           dmin = std::min(dmin, d), dmax = std::max(dmax, d);
+          if (dmax > tol && dmin < -tol) break;  // most triples: no need to see the rest
         }
         if (dmax > tol && dmin < -tol) continue;  // points on both sides: not a hull face
         if (dmax > tol || dmin < -tol) any_volume = true;

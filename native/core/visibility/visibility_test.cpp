@@ -210,6 +210,12 @@ TEST(VisiblePolygon, FormFactorAloneEqualsTheGradientPathsValue) {
     const double alone = visible_form_factor(c.r, c.n, c.emitter, c.occluders);
     const double open = form_factor(c.r, c.n, c.emitter);
     EXPECT_NEAR(alone, with_gradient, 1e-12 * open) << "configuration " << i;
+    // Both report the unoccluded F they bound themselves by, hidden or not.
+    double open_alone = -1.0, open_with_gradient = -1.0;
+    EXPECT_EQ(visible_form_factor(c.r, c.n, c.emitter, c.occluders, &open_alone), alone);
+    visible_form_factor_gradient(c.r, c.n, c.emitter, c.occluders, &open_with_gradient);
+    EXPECT_EQ(open_alone, open) << "configuration " << i;
+    EXPECT_NEAR(open_with_gradient, open, 1e-14 * open) << "configuration " << i;
     occluded += with_gradient < open * (1.0 - 1e-9) ? 1 : 0;
     hidden += with_gradient == 0.0 ? 1 : 0;
   }
@@ -383,7 +389,8 @@ TEST(VisiblePolygon, PartsOfASplitEmitterMatchOneCallPerPart) {
     const std::vector<Polygon> children = children_of(c.emitter);
     std::vector<std::span<const dvec3>> parts(children.begin(), children.end());
     std::vector<FormFactorGradient> together(children.size());
-    visible_form_factor_gradient_parts(c.r, c.n, c.emitter, parts, c.occluders, together);
+    std::vector<double> open(children.size(), -1.0);
+    visible_form_factor_gradient_parts(c.r, c.n, c.emitter, parts, c.occluders, together, open);
     const FormFactorGradient whole = visible_form_factor_gradient(c.r, c.n, c.emitter, c.occluders);
     const double scale = std::max(whole.value, 1e-3);
     double sum = 0.0;
@@ -396,6 +403,9 @@ TEST(VisiblePolygon, PartsOfASplitEmitterMatchOneCallPerPart) {
       worst_gradient = std::max(
           worst_gradient, glm::length(together[k].gradient - alone.gradient) / gradient_scale);
       EXPECT_NEAR(together[k].value, alone.value, 1e-10 * scale)
+          << "configuration " << i << " part " << k;
+      const double part_open = form_factor(c.r, c.n, children[k]);
+      EXPECT_NEAR(open[k], part_open, 1e-14 * std::max(part_open, 1e-3))
           << "configuration " << i << " part " << k;
       EXPECT_LT(glm::length(together[k].gradient - alone.gradient), 1e-8 * gradient_scale)
           << "configuration " << i << " part " << k;
@@ -767,9 +777,14 @@ TEST(SampledVisibility, ConvergesToExactAsRaysGrow) {
       SampledVisibilityOptions options;
       options.rays = ray_counts[k];
       options.seed = static_cast<std::uint64_t>(i);
-      const double a = sampled_form_factor_gradient(c.r, c.n, c.emitter, scene, options).value;
+      double open_a = -1.0, open_b = -1.0;
+      const double a = sampled_form_factor_gradient(c.r, c.n, c.emitter, scene, options, kNoFace,
+                                                    kNoFace, &open_a)
+                           .value;
       const double b =
-          sampled_form_factor_gradient(c.r, c.n, c.emitter, c.occluders, options).value;
+          sampled_form_factor_gradient(c.r, c.n, c.emitter, c.occluders, options, &open_b).value;
+      EXPECT_EQ(open_a, unoccluded);
+      EXPECT_EQ(open_b, unoccluded);
       EXPECT_GE(a, 0.0);
       EXPECT_LE(a, unoccluded);
       embree_error[k] += std::abs(a - exact) / unoccluded / configurations;

@@ -637,9 +637,11 @@ struct PieceSum {
   }
 };
 
-// The visible pieces clipped to a part of the emitter, F and gradient summed.
+// The visible pieces clipped to a part of the emitter, F and gradient summed;
+// `open` receives the part's unoccluded F.
 // The part's edges lie on the emitter plane: fixed lines, like its own edges.
-FormFactorGradient part_form_factor_gradient(Workspace& w, std::span<const dvec3> part) {
+FormFactorGradient part_form_factor_gradient(Workspace& w, std::span<const dvec3> part,
+                                             double& open) {
   const std::size_t lines = w.lines.size();
   w.occluder.clear();  // scratch: the part on the emitter plane
   for (std::size_t i = 0; i < part.size(); ++i) {
@@ -659,7 +661,8 @@ FormFactorGradient part_form_factor_gradient(Workspace& w, std::span<const dvec3
     if (!w.rest.empty()) total.add(form_factor_gradient(w.r, w.n, contour_of(w, w.rest)));
   }
   w.lines.resize(lines);
-  return total.finish(form_factor(w.r, w.n, part));
+  open = form_factor(w.r, w.n, part);
+  return total.finish(open);
 }
 
 // Not inlined on purpose: inlined, the compiler specialises the helpers for the
@@ -687,11 +690,15 @@ VisiblePolygon visible_polygon(const dvec3& r, const dvec3& n, std::span<const d
 
 FormFactorGradient visible_form_factor_gradient(const dvec3& r, const dvec3& n,
                                                 std::span<const dvec3> emitter,
-                                                std::span<const Triangle> occluders) {
+                                                std::span<const Triangle> occluders, double* open) {
   Workspace& w = thread_workspace();
   bool occluded = false;
-  if (!compute_visible_pieces(r, n, emitter, occluders, w, occluded)) return {};
+  if (!compute_visible_pieces(r, n, emitter, occluders, w, occluded)) {
+    if (open) *open = form_factor(r, n, emitter);
+    return {};
+  }
   const FormFactorGradient unoccluded = form_factor_gradient(r, n, emitter);
+  if (open) *open = unoccluded.value;
   if (!occluded) return unoccluded;
   PieceSum total;
   for (std::size_t i = 0; i + 1 < w.start.size(); ++i)
@@ -700,11 +707,13 @@ FormFactorGradient visible_form_factor_gradient(const dvec3& r, const dvec3& n,
 }
 
 double visible_form_factor(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter,
-                           std::span<const Triangle> occluders) {
+                           std::span<const Triangle> occluders, double* open) {
   Workspace& w = thread_workspace();
   bool occluded = false;
-  if (!compute_visible_pieces(r, n, emitter, occluders, w, occluded)) return 0.0;
-  const double unoccluded = form_factor(r, n, emitter);
+  const bool any = compute_visible_pieces(r, n, emitter, occluders, w, occluded);
+  const double unoccluded = any || open ? form_factor(r, n, emitter) : 0.0;
+  if (open) *open = unoccluded;
+  if (!any) return 0.0;
   if (!occluded) return unoccluded;
   PieceSum total;
   for (std::size_t i = 0; i + 1 < w.start.size(); ++i)
@@ -716,14 +725,24 @@ void visible_form_factor_gradient_parts(const dvec3& r, const dvec3& n,
                                         std::span<const dvec3> emitter,
                                         std::span<const std::span<const dvec3>> parts,
                                         std::span<const Triangle> occluders,
-                                        std::span<FormFactorGradient> out) {
+                                        std::span<FormFactorGradient> out, std::span<double> open) {
   std::fill(out.begin(), out.end(), FormFactorGradient{});
   Workspace& w = thread_workspace();
   bool occluded = false;
-  if (!compute_visible_pieces(r, n, emitter, occluders, w, occluded)) return;
-  for (std::size_t i = 0; i < parts.size(); ++i)
-    out[i] =
-        occluded ? part_form_factor_gradient(w, parts[i]) : form_factor_gradient(r, n, parts[i]);
+  if (!compute_visible_pieces(r, n, emitter, occluders, w, occluded)) {
+    for (std::size_t i = 0; i < open.size(); ++i) open[i] = form_factor(r, n, parts[i]);
+    return;
+  }
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    double part_open = 0.0;
+    if (occluded) {
+      out[i] = part_form_factor_gradient(w, parts[i], part_open);
+    } else {
+      out[i] = form_factor_gradient(r, n, parts[i]);
+      part_open = out[i].value;
+    }
+    if (i < open.size()) open[i] = part_open;
+  }
 }
 
 const char* planar_convex_problem(std::span<const dvec3> polygon) {

@@ -61,26 +61,31 @@ VisiblePolygon visible_polygon(const dvec3& r, const dvec3& n, std::span<const d
 
 // Exact form factor of the visible part of the emitter and its gradient with
 // respect to the receiver point: the sum over the convex pieces of the visible
-// region. Always finite, F in [0, unoccluded F].
+// region. Always finite, F in [0, unoccluded F]. If `open` is given, it
+// receives the unoccluded F (which the method computes anyway as its bound;
+// the energy correction needs it too).
 FormFactorGradient visible_form_factor_gradient(const dvec3& r, const dvec3& n,
                                                 std::span<const dvec3> emitter,
-                                                std::span<const Triangle> occluders);
+                                                std::span<const Triangle> occluders,
+                                                double* open = nullptr);
 
 // The visible form factor alone, without its gradient (cheaper: the pieces'
-// vertices need no generating lines).
+// vertices need no generating lines); `open` as above.
 double visible_form_factor(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter,
-                           std::span<const Triangle> occluders);
+                           std::span<const Triangle> occluders, double* open = nullptr);
 
 // The same for several parts of one emitter at once (the children of a split
 // emitter element: convex, counter-clockwise, on the emitter's plane, inside
 // it): the visible region of the whole emitter is computed once, with
 // occluders that cover all the parts, and clipped to each part. out[i] is the
 // visible form factor of parts[i]; equal to one call per part up to rounding.
+// open[i], if `open` is not empty, receives part i's unoccluded F.
 void visible_form_factor_gradient_parts(const dvec3& r, const dvec3& n,
                                         std::span<const dvec3> emitter,
                                         std::span<const std::span<const dvec3>> parts,
                                         std::span<const Triangle> occluders,
-                                        std::span<FormFactorGradient> out);
+                                        std::span<FormFactorGradient> out,
+                                        std::span<double> open = {});
 
 // The emitters this code is exact for: planar and convex, with no repeated
 // vertex (an edge of zero length made every visible piece NaN). nullptr if
