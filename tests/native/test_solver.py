@@ -629,5 +629,21 @@ class QualityRange(unittest.TestCase):
             np.testing.assert_allclose(result.radiance, expected, rtol=1e-5)
 
 
+class Memory(unittest.TestCase):
+    def test_a_refined_solve_holds_no_growth_slack(self):
+        # Per element: the Element (64 B), its vertices and midpoints, the
+        # radiance it sends (24 B) and its energy-balance factors (44 B), about
+        # 180 B once refinement has amortised what each patch holds. Arrays
+        # grown by doubling and never given back held up to 220 B (issue 18).
+        # A link is 40 B, 44 with its receiver grouping.
+        scene = room_with_blocker()[0].scene(rad)
+        for oracle in ORACLES:
+            with self.subTest(oracle=oracle):
+                stats = rad.solve(scene, oracle=oracle, quality=0.5).stats
+                self.assertGreater(stats["elements"], 2000)
+                self.assertLess(stats["bytes_per_element"], 185.0)
+                self.assertLessEqual(stats["bytes_per_link"], 44.0)
+
+
 if __name__ == "__main__":
     unittest.main()

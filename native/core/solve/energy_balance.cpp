@@ -136,6 +136,7 @@ void EnergyBalance::update(const Hierarchy& h, const LinkGather& grouping, const
   // way push/pull hands down what the parent gathers (so that where a child
   // has no links of its own, its closure is what it is handed: no correction).
   const size_t known = closure_.size();
+  closure_.reserve(n);  // exactly n: growth by doubling would leave up to half unused
   closure_.resize(n);
   for (size_t e = known; e < n; ++e) {
     const Element& x = elements[e];
@@ -220,6 +221,7 @@ void EnergyBalance::update(const Hierarchy& h, const LinkGather& grouping, const
 
 void EnergyBalance::sent_radiances(const Hierarchy& h, std::vector<Rgb>& sent) const {
   const auto& elements = h.elements();
+  sent.reserve(elements.size());  // exactly: see closure_ above
   sent.resize(elements.size());
   if (leaf_scale_.size() != elements.size() || root_scale_.size() != h.root_count()) {
     // Not balanced for these elements (before the first update): as they are.

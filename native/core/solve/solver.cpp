@@ -492,6 +492,7 @@ void Solver::snapshot(double threshold) {
   // keeping what each leaf sample gathered. Before the first iteration nothing
   // has been gathered yet (emitters only): the links read zero.
   std::vector<std::array<Rgb, kMaxSamples>> leaf(hierarchy_.elements().size());
+  source_.reserve(hierarchy_.elements().size());  // exactly: no half-empty growth
   source_.resize(hierarchy_.elements().size(), Rgb(0.0));
   group_links();
   gather_far_light();
