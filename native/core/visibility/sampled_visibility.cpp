@@ -10,9 +10,9 @@ namespace radiosity {
 
 namespace {
 
-// Per-thread scratch of the functions below: a link's samples call them
-// hundreds of thousands of times in a large scene, where allocating their
-// buffers each time cost a tenth of the solve.
+// Per-thread scratch of the functions below: a large scene's link samples
+// call them millions of times, and allocating their buffers each time made
+// malloc and free 4 % of a 5,000-face solve.
 struct Scratch {
   EmitterSamples samples;
   std::vector<double> cumulative;

@@ -730,7 +730,8 @@ void visible_form_factor_gradient_parts(const dvec3& r, const dvec3& n,
   Workspace& w = thread_workspace();
   bool occluded = false;
   if (!compute_visible_pieces(r, n, emitter, occluders, w, occluded)) {
-    for (std::size_t i = 0; i < open.size(); ++i) open[i] = form_factor(r, n, parts[i]);
+    for (std::size_t i = 0; i < std::min(open.size(), parts.size()); ++i)
+      open[i] = form_factor(r, n, parts[i]);
     return;
   }
   for (std::size_t i = 0; i < parts.size(); ++i) {
