@@ -91,9 +91,11 @@ struct Workspace {
   std::vector<PlaneVertex> emitter;  // horizon-clipped emitter
   std::vector<dvec3> corners;        // its corners in 3D
   std::vector<dvec3> side_normals;   // of the pyramid from r through the emitter
-  // Visible pieces: vertices[start[i], start[i + 1]), double-buffered.
+  // Visible pieces: vertices[start[i], start[i + 1]), double-buffered, and
+  // each piece's bounding box (low, high), kept with it.
   std::vector<PlaneVertex> pieces, next_pieces;
   std::vector<std::uint32_t> start, next_start;
+  std::vector<dvec2> box, next_box;
   // Scratch.
   std::vector<PlaneVertex> occluder, rest, inside;
   std::vector<SpaceVertex> space_a, space_b;
@@ -394,15 +396,10 @@ bool keep_inside(Workspace& w, const HalfPlane& h) {
 // is left inside all edges is hidden.
 void subtract_occluder(Workspace& w) {
   const std::span<const PlaneVertex> q(w.occluder);
-  w.halves.resize(q.size());
-  for (std::size_t i = 0; i < q.size(); ++i) w.halves[i] = edge_half_plane(q, i);
-  w.next_pieces.clear();
-  w.next_start.assign(1, 0);
-  const auto close_piece = [&] {
-    w.next_start.push_back(static_cast<std::uint32_t>(w.next_pieces.size()));
-  };
   // Bounding boxes first: most pieces lie far from a given occluder, and the
-  // box test is much cheaper than the separating-axis test.
+  // box test is much cheaper than the separating-axis test. An occluder that
+  // meets no piece's box (it falls where all is hidden already) changes
+  // nothing: no copy of the pieces.
   dvec2 q_low(std::numeric_limits<double>::infinity()),
       q_high(-std::numeric_limits<double>::infinity());
   for (const PlaneVertex& v : q) {
@@ -411,19 +408,45 @@ void subtract_occluder(Workspace& w) {
   }
   q_low -= w.tol.plane;
   q_high += w.tol.plane;
-  for (std::size_t piece = 0; piece + 1 < w.start.size(); ++piece) {
+  const std::size_t count = w.start.size() - 1;
+  const auto apart = [&](std::size_t piece) {
+    const dvec2& p_low = w.box[2 * piece];
+    const dvec2& p_high = w.box[2 * piece + 1];
+    return p_high.x <= q_low.x || p_low.x >= q_high.x || p_high.y <= q_low.y || p_low.y >= q_high.y;
+  };
+  std::size_t near = 0;
+  while (near < count && apart(near)) ++near;
+  if (near == count) return;
+
+  w.halves.resize(q.size());
+  for (std::size_t i = 0; i < q.size(); ++i) w.halves[i] = edge_half_plane(q, i);
+  w.next_pieces.clear();
+  w.next_start.assign(1, 0);
+  w.next_box.clear();
+  // Closes the piece written since the last close, with its box.
+  const auto close_piece = [&] {
+    const std::uint32_t first = w.next_start.back();
+    dvec2 low = w.next_pieces[first].p, high = low;
+    for (std::size_t i = first + 1; i < w.next_pieces.size(); ++i) {
+      low = glm::min(low, w.next_pieces[i].p);
+      high = glm::max(high, w.next_pieces[i].p);
+    }
+    w.next_box.push_back(low);
+    w.next_box.push_back(high);
+    w.next_start.push_back(static_cast<std::uint32_t>(w.next_pieces.size()));
+  };
+  // Pieces kept whole keep their box.
+  const auto keep_piece = [&](std::size_t piece, std::span<const PlaneVertex> p) {
+    w.next_pieces.insert(w.next_pieces.end(), p.begin(), p.end());
+    w.next_box.push_back(w.box[2 * piece]);
+    w.next_box.push_back(w.box[2 * piece + 1]);
+    w.next_start.push_back(static_cast<std::uint32_t>(w.next_pieces.size()));
+  };
+  for (std::size_t piece = 0; piece < count; ++piece) {
     const std::span<const PlaneVertex> p(w.pieces.data() + w.start[piece],
                                          w.start[piece + 1] - w.start[piece]);
-    dvec2 p_low = p[0].p, p_high = p[0].p;
-    for (const PlaneVertex& v : p) {
-      p_low = glm::min(p_low, v.p);
-      p_high = glm::max(p_high, v.p);
-    }
-    const bool apart =
-        p_high.x <= q_low.x || p_low.x >= q_high.x || p_high.y <= q_low.y || p_low.y >= q_high.y;
-    if (apart || disjoint(p, q, w.halves, w.tol)) {
-      w.next_pieces.insert(w.next_pieces.end(), p.begin(), p.end());
-      close_piece();
+    if (piece < near || apart(piece) || disjoint(p, q, w.halves, w.tol)) {
+      keep_piece(piece, p);
       continue;
     }
     w.rest.assign(p.begin(), p.end());
@@ -438,6 +461,7 @@ void subtract_occluder(Workspace& w) {
   }
   std::swap(w.pieces, w.next_pieces);
   std::swap(w.start, w.next_start);
+  std::swap(w.box, w.next_box);
 }
 
 // Frame, tolerances, line table and the horizon-clipped emitter. Returns false
@@ -550,6 +574,12 @@ bool compute_visible_pieces(const dvec3& r, const dvec3& n, std::span<const dvec
   if (emitter.size() < 3 || !setup(r, n, emitter, w)) return false;
   w.pieces.assign(w.emitter.begin(), w.emitter.end());
   w.start.assign({0u, static_cast<std::uint32_t>(w.emitter.size())});
+  dvec2 low = w.emitter[0].p, high = low;
+  for (const PlaneVertex& v : w.emitter) {
+    low = glm::min(low, v.p);
+    high = glm::max(high, v.p);
+  }
+  w.box.assign({low, high});
   dvec3 quad[4];
   for (std::size_t i = 0; i < occluders.size(); ++i) {
     const std::size_t lines = w.lines.size(), anchors = w.anchors.size();
