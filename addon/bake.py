@@ -163,6 +163,7 @@ def write_refined(scene, exported, result, show_wireframe=False, convert=None, m
             # default, and says so to whoever looks at its custom properties.
             obj[GENERATED_NOTE_TAG] = GENERATED_NOTE
             obj.hide_select = True
+            obj.visible_camera = part.camera_visible  # as Cycles shows the original
             obj.show_wire = show_wireframe
             obj.show_all_edges = True
             new_objects.append(obj)

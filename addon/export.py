@@ -65,6 +65,10 @@ class Part:
     # how many it has: faces with non-finite coordinates are left out.
     polygons: np.ndarray = None
     polygon_count: int = 0
+    # Whether Cycles shows it to the camera (Object > Visibility > Ray Visibility >
+    # Camera; off by default for lights, so an area light in view renders black):
+    # its result object shows it or not the same way.
+    camera_visible: bool = True
 
 
 @dataclass
@@ -354,7 +358,8 @@ def export_scene(context, blender_version=None):
             builder.add(points, np.arange(n), [n], [0.0, 0.0, 0.0], radiance, False, occludes=False)
             part = Part(name=_unique(names_used, original.name), source=owner.name,
                         is_instance=inst.is_instance, is_light=True, face_count=1,
-                        corner_points=points, face_sizes=np.array([n]))
+                        corner_points=points, face_sizes=np.array([n]),
+                        camera_visible=_camera_visible(original, owner))
             parts.append(part)
             hidden_sources.add(owner.name)
             continue
@@ -391,7 +396,8 @@ def export_scene(context, blender_version=None):
                     is_instance=inst.is_instance, is_light=False, face_count=len(sizes),
                     corner_points=world[corners], face_sizes=sizes,
                     materials=materials, material_index=slot,
-                    polygons=polygons, polygon_count=polygon_count)
+                    polygons=polygons, polygon_count=polygon_count,
+                    camera_visible=_camera_visible(original, owner))
         if uvs is not None:
             part.uv_layers, part.triangles, part.triangle_face = uvs.corners(mirrored)
             part.uv_render = uvs.render
@@ -499,6 +505,12 @@ def world_radiance(world):
             colour = np.array(node.inputs["Color"].default_value[:3], dtype=float) * strength
             return light_units.world_radiance(colour, 1.0) if np.any(colour > 0) else None, ""
     return None, "world %s (only a uniform Background colour is modelled)" % world.name
+
+
+def _camera_visible(original, owner):
+    """Cycles' camera ray visibility of an object, or of an instance (its own and its
+    instancer's)."""
+    return bool(original.visible_camera and owner.visible_camera)
 
 
 def _unique(used, name):

@@ -14,6 +14,9 @@
    snapshots, error against a refined solution and a Cycles render, Cycles
    bake comparison; <build>/bench/study.csv, study_*.png and report.md. Quick
    mode: fewer points, smaller images, fewer samples (a few minutes).
+5. Finely tessellated objects (bench/tessellated_room.py, in Blender): exact
+   and sampled visibility against a path trace; <build>/bench/tessellated_room.md.
+   Quick mode: the UV sphere only.
 """
 
 import argparse
@@ -50,6 +53,10 @@ def main():
     print("== speed-accuracy study", flush=True)
     subprocess.run([sys.executable, str(ROOT / "bench" / "study.py"), "--build", args.build, "--blender",
                     args.blender, "--mode", "quick" if args.quick else "full"], check=True)
+    print("== finely tessellated objects", flush=True)
+    subprocess.run([args.blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
+                    str(ROOT / "bench" / "tessellated_room.py"), "--", "--build", args.build]
+                   + (["--quick"] if args.quick else []), check=True)
 
 
 if __name__ == "__main__":

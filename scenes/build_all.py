@@ -13,9 +13,9 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from catalog import CONTACT_SCENES, LIGHT_SCENES, SCENES  # noqa: E402
+from catalog import CONTACT_SCENES, LIGHT_SCENES, SCENES, TESSELLATED_SCENES  # noqa: E402
 
-ALL = {**SCENES, **CONTACT_SCENES, **LIGHT_SCENES}
+ALL = {**SCENES, **CONTACT_SCENES, **LIGHT_SCENES, **TESSELLATED_SCENES}
 
 
 def build_scene(blender, name, out):

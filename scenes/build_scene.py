@@ -2,7 +2,7 @@
 
     blender -b --factory-startup --python scenes/build_scene.py -- NAME OUT.blend
 
-NAME is one of catalog.SCENES, catalog.CONTACT_SCENES or catalog.LIGHT_SCENES; each has a module NAME.py
+NAME is one of catalog.SCENES, CONTACT_SCENES, LIGHT_SCENES or TESSELLATED_SCENES; each has a module NAME.py
 here with build(scene).
 """
 
@@ -21,7 +21,7 @@ import scene_kit  # noqa: E402
 def build(name, scene, **params):
     """Fill `scene` (empty) with the scene called `name`; `params` go to its
     builder (e.g. the Cornell box's gap=0.01)."""
-    known = {**catalog.SCENES, **catalog.CONTACT_SCENES, **catalog.LIGHT_SCENES}
+    known = {**catalog.SCENES, **catalog.CONTACT_SCENES, **catalog.LIGHT_SCENES, **catalog.TESSELLATED_SCENES}
     if name not in known:
         raise ValueError("unknown scene %r; known: %s" % (name, ", ".join(known)))
     importlib.import_module(name).build(scene, **params)

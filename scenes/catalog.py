@@ -37,3 +37,11 @@ LIGHT_SCENES = {
     "lights_room": "4 x 3 x 2.6 m room with a window: a point light, a soft-edged spot, the sun and the "
                    "world through the window (build(scene, lights=...) takes a subset)",
 }
+
+# A room of finely tessellated objects modelled with Blender's operators (a UV
+# sphere, a subdivided Suzanne): what many small faces close together cost
+# (bench/tessellated_room.py). Not in SCENES: minutes to solve.
+TESSELLATED_SCENES = {
+    "tessellated_room": "4 x 3 x 2.5 m room from the default cube: a textured rug, a UV sphere, a box, a subdivided "
+                        "Suzanne; a disk light under the ceiling and a point light",
+}

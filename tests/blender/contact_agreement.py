@@ -61,6 +61,9 @@ CASES = {
     "lights_sun": ("lights_room", {"lights": ["sun"]}),
     "lights_world": ("lights_room", {"lights": ["world"]}),
     "lights_all": ("lights_room", {}),
+    # Finely tessellated objects (bench/tessellated_room.py): the sphere alone, then with Suzanne.
+    "tessellated_sphere": ("tessellated_room", {"objects": ["rug", "sphere", "box"]}),
+    "tessellated_monkey": ("tessellated_room", {}),
 }
 GAPS = (("0.1 mm", "cornell_box"), ("1 mm", "cornell_box_1mm"), ("1 cm", "cornell_box_1cm"),
         ("5 cm", "cornell_box_5cm"))

@@ -9,6 +9,8 @@
   sun, see the test): mean brightness within 3 % and the
   median 8 x 8-block error within 6 % of a path trace (contact_agreement.py
   says how; the reference is cached).
+- An area light in view: Cycles shows it to the camera only if its object's
+  Ray Visibility > Camera is on (off by default), and so does its result.
 """
 
 import unittest
@@ -17,6 +19,8 @@ import bpy
 import numpy as np
 
 import contact_agreement as ca
+import render_compare as rc
+import scene_kit
 from radiosity import export
 
 
@@ -60,6 +64,48 @@ class DefaultSceneTest(unittest.TestCase):
         # sky below (the world lies all around, as in Cycles).
         np.testing.assert_allclose(colours[top], rho * (direct[:, None] + world), rtol=0.02)
         np.testing.assert_allclose(colours[bottom], np.tile(rho * world, (len(bottom), 1)), rtol=0.02)
+
+
+class AreaLightInViewTest(unittest.TestCase):
+    """A floor under an area light, the camera looking up at the light's emitting
+    side. Where Cycles shows the light when its camera visibility is on, the
+    solution's render must show it as bright, and as black (the world behind it)
+    when it is off, as by default."""
+
+    RESOLUTION = (96, 96)
+
+    def test_result_follows_the_lights_camera_visibility(self):
+        scene = scene_kit.empty_file()
+        scene_kit.setup_render(scene)
+        bpy.ops.mesh.primitive_plane_add(size=4)
+        bpy.context.object.data.materials.append(scene_kit.lambertian_material("Floor", (0.6, 0.6, 0.6)))
+        bpy.ops.object.light_add(type='AREA', location=(0, 0, 1.5))   # emitting downwards
+        light = bpy.context.object
+        light.data.size, light.data.energy = 1.0, 100.0
+        scene_kit.add_camera(scene, (0, -3, 0.5), (0, 0, 1.5))
+
+        def luminance(image):
+            return image[..., :3] @ rc.LUMINANCE
+
+        light.visible_camera = True
+        shown = luminance(rc.render_image(scene, 16, self.RESOLUTION, seed=1))
+        # The pixels the light covers with the whole of their filter: its edge is
+        # where the two renders' sampling noise would differ.
+        on_light = shown > 0.95 * shown.max()
+        light.visible_camera = False
+        hidden = luminance(rc.render_image(scene, 16, self.RESOLUTION, seed=1))
+        cycles = {True: shown[on_light].mean(), False: hidden[on_light].mean()}
+        self.assertGreater(on_light.sum(), 10)
+        self.assertLess(cycles[False], 0.01 * cycles[True])
+        for visible in (False, True):
+            light.visible_camera = visible
+            self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
+            solution = luminance(rc.render_image(scene, 8, self.RESOLUTION, seed=0))[on_light].mean()
+            print("[area light in view] camera visibility %s: the light's pixels %.3g, Cycles %.3g"
+                  % (visible, solution, cycles[visible]))
+            with self.subTest(camera_visibility=visible):
+                self.assertAlmostEqual(solution / cycles[True], cycles[visible] / cycles[True], delta=0.05)
+                self.assertEqual(bpy.data.objects[light.name + " Radiosity"].visible_camera, visible)
 
 
 class LightsAgreementTest(unittest.TestCase):
