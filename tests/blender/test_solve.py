@@ -371,6 +371,8 @@ class VisibilityHintTest(unittest.TestCase):
         hint = pipeline.visibility_hint("exact", {"seconds_linking": 42.0})
         self.assertIn("Sampled", hint)
         self.assertIn("42 s", hint)
+        self.assertIn("(418,452 links)", pipeline.visibility_hint("exact", {"seconds_linking": 12.0,
+                                                                            "links": 418452}))
         self.assertEqual(pipeline.visibility_hint("exact", {"seconds_linking": 2.0}), "")
         self.assertEqual(pipeline.visibility_hint("sampled", {"seconds_linking": 42.0}), "")
         self.assertEqual(pipeline.visibility_hint("exact", {}), "")
