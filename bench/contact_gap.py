@@ -17,30 +17,18 @@ same cached references (<build>/contact_cache): after the first run only the
 solves and their 8-sample renders cost time (--quick: about a minute).
 """
 
-import argparse
-import os
 import pathlib
 import sys
 import time
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-
-
-def arguments():
-    parser = argparse.ArgumentParser(prog="contact_gap.py")
-    parser.add_argument("--build", default=str(ROOT / "build"), help="build tree (its addon/ is loaded)")
-    parser.add_argument("--quick", action="store_true", help="quality 0.5 only")
-    parser.add_argument("--images", help="write the reference and solution renders here as PNG")
-    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    return parser.parse_args(argv)
+sys.path.insert(0, str(ROOT / "bench"))
+import in_blender  # noqa: E402
 
 
 def main():
-    args = arguments()
-    sys.path.insert(0, str(pathlib.Path(args.build).resolve() / "addon"))
-    sys.path.insert(0, str(ROOT / "tests" / "blender"))
-    import radiosity
-    radiosity.register()
+    args = in_blender.arguments("contact_gap.py", "quality 0.5 only")
+    radiosity = in_blender.load_addon(args.build)
     import contact_agreement as ca
     import image_agreement
 

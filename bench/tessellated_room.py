@@ -12,32 +12,22 @@ measurement and cache). --quick: the sphere case only (about two minutes
 after its reference is cached); the Suzanne case takes 20 to 30 minutes.
 """
 
-import argparse
 import pathlib
 import sys
 import time
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "bench"))
+import in_blender  # noqa: E402
+
 CASES = ("tessellated_sphere", "tessellated_monkey")
 VISIBILITIES = ("SAMPLED", "EXACT")
 ORACLES = ("STANDARD", "PERCEPTUAL")
 
 
-def arguments():
-    parser = argparse.ArgumentParser(prog="tessellated_room.py")
-    parser.add_argument("--build", default=str(ROOT / "build"), help="build tree (its addon/ is loaded)")
-    parser.add_argument("--quick", action="store_true", help="the sphere case only")
-    parser.add_argument("--images", help="write the reference and solution renders here as PNG")
-    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    return parser.parse_args(argv)
-
-
 def main():
-    args = arguments()
-    sys.path.insert(0, str(pathlib.Path(args.build).resolve() / "addon"))
-    sys.path.insert(0, str(ROOT / "tests" / "blender"))
-    import radiosity
-    radiosity.register()
+    args = in_blender.arguments("tessellated_room.py", "the sphere case only")
+    in_blender.load_addon(args.build)
     import contact_agreement as ca
     import image_agreement
 
