@@ -100,7 +100,7 @@ class Scene:
     fmt: str               # what Blender imports: "glb" or "obj" (after conversion)
     licence: str
     origin: str            # who made it, as the artifact or its source says
-    triangles: int         # counted by Blender after import_scene.py's import
+    triangles: int         # counted by Blender 3.4 after import_scene.py's import (its imported.json)
     lights: str            # lights or emitters the file brings
     added: str             # what import_scene.py adds where it brings none
     interior: str          # what is inside: furnished or not
@@ -123,7 +123,7 @@ SCENES = {s.name: s for s in (
         licence="'Used with permission and fine to redistribute, KIT/IAI would appreciate if the attribution "
                 "was retained' (AC14-FZK-Haus.source.txt; Debian: assimp-testmodels, main)",
         origin="KIT/IAI (Karlsruhe Institute of Technology), ArchiCAD 14 IFC export",
-        triangles=0,
+        triangles=35899,
         lights="none (IFC has no light sources; 11 assimp materials, colours only)",
         added="a ceiling area light in each storey's main room (see import_scene.py)",
         interior="two-storey house with roof: kitchen units, table and chairs, beds, bath (21 IfcFurnishingElement)",
@@ -137,7 +137,7 @@ SCENES = {s.name: s for s in (
         licence="none stated in the jar; Crytek Sponza is CC BY 3.0 (Frank Meinl, Crytek); "
                 "jMonkeyEngine is BSD-3-Clause",
         origin="Crytek Sponza (identified by its 37 x 22 x 15 m extent and 279,163 triangles in one geometry)",
-        triangles=0,
+        triangles=279157,
         lights="none (one geometry, no material: its textures are not in the jar)",
         added="an area light filling the roof opening, facing down (the sky as a window)",
         interior="atrium with arcades, columns, drapes and plant pots; no furniture",
@@ -153,7 +153,7 @@ SCENES = {s.name: s for s in (
         fmt="obj",
         licence="pybullet is zlib-licensed; the model's own licence is not stated",
         origin="Bullet Physics' pybullet_data (Blender 2.66 OBJ export, 81 materials, textures not shipped)",
-        triangles=0,
+        triangles=124789,
         lights="none",
         added="a sun and a uniform grey sky (World colour): it is an open temple precinct",
         interior="buildings, walls and stairs of a temple precinct, seen from outside; no furniture",
