@@ -248,6 +248,8 @@ def solve(args, name, blend, quality, ref, mask, folder):
                limit_seconds=args.limit, limit_gb=args.memory, time_budget=args.time_budget)
     if out.exists():
         row.update(json.loads(out.read_text()))
+    row["log"] = str(out.with_suffix(".log"))
+    row["last_progress"] = last_progress(row["log"])
     if outcome == "time":
         row["result"] = "did not finish within %.0f s" % args.limit
     elif outcome == "memory":
@@ -261,13 +263,24 @@ def solve(args, name, blend, quality, ref, mask, folder):
     return row
 
 
+def last_progress(log):
+    """The add-on's last progress line in a solve's log (where a stopped solve was)."""
+    lines = [x for x in pathlib.Path(log).read_text(errors="replace").splitlines() if x.startswith("Radiosity:")]
+    return lines[-1][len("Radiosity:"):].strip() if lines else None
+
+
 def fmt_row(r):
     def num(key, pattern, scale=1.0):
         return pattern % (r[key] * scale) if r.get(key) is not None else "-"
+    quality = num("quality", "%.2f") if "quality" in r else r["quality_asked"]
+    if quality == "default":
+        quality = "default (%s)" % r.get("default_quality")
+    result = r.get("result", "-")
+    if r.get("last_progress") and "exposure" not in r:
+        result += "; last progress: " + r["last_progress"]
     return "| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
-        r["scene"], format(r["triangles"], ",") if r.get("triangles") else "?",
-        num("quality", "%.2f") if "quality" in r else r["quality_asked"],
-        "%g" % r["time_budget"] if r["time_budget"] else "none", r.get("result", "-"),
+        r["scene"], format(r["triangles"], ",") if r.get("triangles") else "?", quality,
+        "%g" % r["time_budget"] if r["time_budget"] else "none", result,
         num("wall_seconds", "%.1f"), num("peak_gb", "%.2f") if r.get("peak_gb") else "(%.2f)" % r["largest_rss_gb"],
         format(r["elements"], ",") if r.get("elements") else "-", format(r["links"], ",") if r.get("links") else "-",
         num("exposure", "%+.1f %%", 100), num("block", "%.1f %%", 100))
@@ -296,11 +309,14 @@ def main():
     parser.add_argument("--memory", type=float, default=8.0, help="GB a Blender process may hold resident")
     parser.add_argument("--time-budget", type=float, default=0.0, help="the add-on's Time Limit setting (0: none)")
     parser.add_argument("--qualities", default="0,default", help="comma-separated; 'default': the add-on's")
+    parser.add_argument("--table-only", action="store_true", help="only print the table of results.json")
     parser.add_argument("names", nargs="*")
     args = parser.parse_args()
     args.build = str(pathlib.Path(args.build).resolve())
     args.addon_build = str(pathlib.Path(args.addon_build or args.build).resolve())
     qualities = [None if q == "default" else float(q) for q in args.qualities.split(",")]
+    if args.table_only:
+        return write_results(args, [])
     version = blender_version(args.blender)
     out = catalog.furnished_dir(args.build)
     imported = out / "imported.json"
@@ -321,11 +337,25 @@ def main():
             print(fmt_row(row), flush=True)
     for row in rows:
         row.update(addon_build=args.addon_build, addon_commit=git_commit(args.addon_build))
-    # Rows of other scenes, qualities or budgets measured before are kept.
+    write_results(args, rows)
+
+
+def write_results(args, rows):
+    """Merges `rows` into <build>/furnished/results.json (keeping the other scenes, qualities
+    and budgets measured before) and writes the table to results.md."""
+    out = catalog.furnished_dir(args.build)
+    defaults = json.loads((pathlib.Path(args.addon_build) / "addon" / "radiosity" / "solver_defaults.json").read_text())
     results = out / "results.json"
     measured = {(r["scene"], r["quality_asked"], r["time_budget"]): r for r in rows}
     earlier = json.loads(results.read_text())["rows"] if results.exists() else []
     rows = [r for r in earlier if (r["scene"], r["quality_asked"], r["time_budget"]) not in measured] + rows
+    for row in rows:
+        if "log" not in row:   # rows of the first version of this script
+            logs = sorted((out / "cache").glob("%s_*/solve_q%s_b%g.log" % (row["scene"], row["quality_asked"],
+                                                                          row["time_budget"])))
+            row["log"] = str(logs[-1]) if logs else None
+            row["last_progress"] = last_progress(logs[-1]) if logs else None
+        row.setdefault("default_quality", defaults["quality"])
     rows.sort(key=lambda r: (list(catalog.SCENES).index(r["scene"]) if r["scene"] in catalog.SCENES else 99,
                              r["time_budget"], r["quality_asked"]))
     table = "\n".join(HEADER + [fmt_row(r) for r in rows])
