@@ -243,9 +243,11 @@ class Clustering(unittest.TestCase):
         self.assertGreater(clustered.stats["cluster_links"], 100)
         self.assertEqual(pairs.stats["cluster_links"], 0)
         self.assertLess(clustered.stats["links"], 0.8 * pairs.stats["links"])
-        # Unrefined, both give the same mesh; the radiance agrees closely.
+        # Unrefined, both give the same mesh; the radiance agrees closely (at
+        # quality 0 clusters link from twice their radii, both ends clusters:
+        # 0.8 % on average, where sides linked one by one were 0.5 %).
         np.testing.assert_array_equal(clustered.face_vertices, pairs.face_vertices)
-        self.assertLess(np.abs(clustered.radiance - pairs.radiance).mean() / pairs.radiance.mean(), 5e-3)
+        self.assertLess(np.abs(clustered.radiance - pairs.radiance).mean() / pairs.radiance.mean(), 1e-2)
         np.testing.assert_allclose(clustered.radiance, pairs.radiance, rtol=0.05, atol=0.02 * pairs.radiance.max())
         # The room is closed: what the cluster links carry is absorbed like the rest.
         np.testing.assert_allclose(absorbed_power(b, clustered), absorbed_power(b, pairs), rtol=3e-3)

@@ -15,7 +15,22 @@ int facing_class(const dvec3& n) {
   return 2 * axis + (n[axis] < 0.0 ? 1 : 0);
 }
 
+// The second moment of a triangle's area about the origin: the integral of
+// x x^T, (A / 12) (sum of v v^T + s s^T) with s the sum of its corners.
+glm::dmat3 triangle_moment(const dvec3& a, const dvec3& b, const dvec3& c) {
+  const double area = 0.5 * glm::length(glm::cross(b - a, c - a));
+  const dvec3 s = a + b + c;
+  return area / 12.0 *
+         (glm::outerProduct(a, a) + glm::outerProduct(b, b) + glm::outerProduct(c, c) +
+          glm::outerProduct(s, s));
+}
+
 }  // namespace
+
+glm::dmat3 ClusterNode::covariance_matrix() const {
+  const auto& c = covariance;
+  return glm::dmat3(c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5]);
+}
 
 ClusterTree::ClusterTree(const Hierarchy& hierarchy) {
   for (std::uint32_t p = 0; p < hierarchy.scene().patches.size(); ++p) {
@@ -58,17 +73,30 @@ std::int32_t ClusterTree::build(const Hierarchy& hierarchy, std::uint32_t first,
     node.centre += e.area * hierarchy.centre(e);
     node.area += e.area;
     node.reflects |= luminance(hierarchy.reflectance(e)) > 0.0;
+    node.reflectance =
+        std::max(node.reflectance, static_cast<float>(luminance(hierarchy.reflectance(e))));
     node.sends |=
         luminance(hierarchy.reflectance(e)) > 0.0 || luminance(hierarchy.emission(e)) > 0.0;
     node.emits |= luminance(hierarchy.emission(e)) > 0.0;
   }
   node.centre = node.area > 0.0 ? node.centre / node.area : 0.5 * (lo + hi);
+  glm::dmat3 moment(0.0);  // of the area about the centre
   for (auto it = begin; it != end; ++it) {
     dvec3 corners[4];
     const int n = hierarchy.corners(hierarchy.element(*it), corners);
-    for (int k = 0; k < n; ++k)
-      node.radius = std::max(node.radius, glm::length(corners[k] - node.centre));
+    for (int k = 0; k < n; ++k) {
+      corners[k] -= node.centre;
+      node.radius = std::max(node.radius, glm::length(corners[k]));
+    }
+    for (int k = 1; k + 1 < n; ++k) moment += triangle_moment(corners[0], corners[k], corners[k + 1]);
   }
+  if (node.area > 0.0) {
+    const glm::dmat3 c = moment / node.area;
+    node.covariance = {static_cast<float>(c[0][0]), static_cast<float>(c[0][1]),
+                       static_cast<float>(c[0][2]), static_cast<float>(c[1][1]),
+                       static_cast<float>(c[1][2]), static_cast<float>(c[2][2])};
+  }
+  node.area_normal = weighted_normal;
   const double length = glm::length(weighted_normal);
   node.axis = length > 0.0 ? weighted_normal / length : hierarchy.normal(hierarchy.element(*begin));
   for (auto it = begin; it != end; ++it) {
@@ -88,10 +116,13 @@ std::int32_t ClusterTree::build(const Hierarchy& hierarchy, std::uint32_t first,
   }
 
   if (count > 1) {
-    // Facing classes first (sides in one class face within 55 degrees of an
-    // axis), then halves along the longest extent of the centres.
+    // Emitting sides apart from the others (so a cluster's light is its
+    // sides' own, not a lamp's averaged with the ceiling around it), then
+    // facing classes (sides in one class face within 55 degrees of an axis),
+    // then halves along the longest extent of the centres.
     const auto class_of = [&](std::int32_t e) {
-      return facing_class(hierarchy.normal(hierarchy.element(e)));
+      const Element& x = hierarchy.element(e);
+      return facing_class(hierarchy.normal(x)) + (luminance(hierarchy.emission(x)) > 0.0 ? 6 : 0);
     };
     const auto centre_of = [&](std::int32_t e) { return hierarchy.centre(hierarchy.element(e)); };
     std::stable_sort(begin, end,

@@ -6,6 +6,7 @@
 // another and exchange light with it through one link (cluster_links.h).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -14,9 +15,10 @@
 namespace radiosity {
 
 struct ClusterNode {
-  dvec3 centre{0.0};    // area-weighted centroid of its sides
-  double radius = 0.0;  // of the sphere about `centre` holding every side
-  dvec3 axis{0.0};      // of the normals' cone (area-weighted mean normal)
+  dvec3 centre{0.0};       // area-weighted centroid of its sides
+  double radius = 0.0;     // of the sphere about `centre` holding every side
+  dvec3 axis{0.0};         // of the normals' cone (area-weighted mean normal)
+  dvec3 area_normal{0.0};  // sum of its sides' area times normal
   double spread = 0.0;  // the cone's half-angle, radians
   // Heights of its sides' corners along `axis`: where every side faces along
   // the axis (is_flat: a floor, a tiled wall), a side sees only what rises
@@ -25,6 +27,12 @@ struct ClusterNode {
   bool is_flat() const { return spread < kFlatSpread; }
   static constexpr double kFlatSpread = 1e-6;  // radians
   double area = 0.0;
+  // How its area spreads about `centre`: the covariance of a uniform point of
+  // its sides (xx, xy, xz, yy, yz, zz), for the second-order correction of
+  // cluster links (cluster_links.h).
+  std::array<float, 6> covariance{};
+  glm::dmat3 covariance_matrix() const;
+  float reflectance = 0.0f;  // the largest luminance of its sides' reflectance
   std::int32_t child[2] = {kNone, kNone};
   std::uint32_t first = 0, count = 0;  // its sides: ClusterTree::sides()[first, first + count)
   bool reflects = false;               // some side reflects (can receive)

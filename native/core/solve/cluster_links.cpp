@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <numbers>
+#include <limits>
 #include <span>
 
 #include "core/geometry/random.h"
@@ -69,12 +70,13 @@ std::vector<SideSample> side_samples(const ClusterTree& tree, const Hierarchy& h
   return out;
 }
 
-// A point uniformly distributed over the node's sides (area-weighted).
-dvec3 random_point(const ClusterTree& tree, std::span<const SideSample> sides,
-                   const ClusterNode& node, SplitMix64& random, std::uint32_t& face) {
-  const auto& prefix = tree.area_prefix();
-  const double target = prefix[node.first] +
-                        random.uniform() * (prefix[node.first + node.count] - prefix[node.first]);
+// A point of the node's sides, weighted by `prefix` (area, or flux: sums over
+// the sides in tree order): the side holding the quantile `u` of the node,
+// then a uniform point of it. Area where the node holds no flux.
+dvec3 point_at(std::span<const double> prefix, std::span<const SideSample> sides,
+               const ClusterNode& node, double u, SplitMix64& random, std::uint32_t& face) {
+  const double target =
+      prefix[node.first] + u * (prefix[node.first + node.count] - prefix[node.first]);
   const auto it = std::upper_bound(prefix.begin() + node.first + 1,
                                    prefix.begin() + node.first + node.count, target);
   const SideSample& side = sides[static_cast<size_t>(it - prefix.begin()) - 1];
@@ -99,24 +101,111 @@ struct PairOutcome {
 };
 
 // Of `rays` shadow rays between random points of the two clusters' sides, how
-// many pass. Seeded by the pair: the answer does not depend on threads.
+// many pass. The points are stratified over each cluster (ray k ends in the
+// k-th of `rays` equal shares of the receiver's area, and starts in the
+// share counted from the other end of the emitter's flux: the visible
+// fraction is of the light it sends), so a side holding a share gets a ray:
+// a small side hidden behind the rest of its cluster is not missed by
+// chance. Seeded by the pair: the answer does not depend on threads.
 int passing_rays(const ClusterTree& tree, std::span<const SideSample> sides, const RayScene& scene,
-                 std::int32_t receiver, std::int32_t emitter, int rays) {
+                 std::span<const double> flux_prefix, std::int32_t receiver, std::int32_t emitter,
+                 int rays) {
+  const ClusterNode& from_node = tree.node(emitter);
+  const bool by_flux = !flux_prefix.empty() && flux_prefix[from_node.first + from_node.count] >
+                                                   flux_prefix[from_node.first];
+  const std::span<const double> from_prefix = by_flux ? flux_prefix : tree.area_prefix();
   SplitMix64 random{(static_cast<std::uint64_t>(static_cast<std::uint32_t>(receiver)) << 32) |
                     static_cast<std::uint32_t>(emitter)};
   int passed = 0;
   for (int k = 0; k < rays; ++k) {
     std::uint32_t from_face = 0, to_face = 0;
-    const dvec3 from = random_point(tree, sides, tree.node(emitter), random, from_face);
-    const dvec3 to = random_point(tree, sides, tree.node(receiver), random, to_face);
+    const double share_from = (rays - 1 - k + random.uniform()) / rays;
+    const double share_to = (k + random.uniform()) / rays;
+    const dvec3 from = point_at(from_prefix, sides, from_node, share_from, random, from_face);
+    const dvec3 to = point_at(tree.area_prefix(), sides, tree.node(receiver), share_to, random, to_face);
     passed += scene.occluded(from, to, from_face, to_face) ? 0 : 1;
   }
   return passed;
 }
 
-PairOutcome classify(const ClusterTree& tree, const Hierarchy& hierarchy,
-                     std::span<const SideSample> sides, const RayScene& scene, double separation,
-                     int rays, std::int32_t x, std::int32_t y) {
+// Nearer than this many times the sum of their radii, no pair is one link:
+// the point approximation has no bound there (the gap could be nothing).
+constexpr double kMinSeparation = 2.0;
+
+// The light a link from cluster y to cluster x (centres d apart) could
+// carry, over the adaptation radiance times the total area (infinite where
+// the criterion knows no light), and whether distance alone takes the pair.
+// Light straight from emitters, the brightest in any scene, is taken only by
+// the light it carries, never by distance alone.
+struct Judgement {
+  bool too_near = true;      // nearer than kMinSeparation: never one link
+  bool by_distance = false;  // further than the separation
+  double light = 0.0;        // relative, as above
+  double error = 1.0;        // relative error of the point approximation
+};
+
+Judgement judge(const ClusterNode& rx, const ClusterNode& ry, std::int32_t y, double d,
+                const ClusterCriterion& c) {
+  Judgement j;
+  const double sum = rx.radius + ry.radius;
+  j.too_near = !(d > kMinSeparation * sum);
+  j.by_distance = !ry.emits && d > c.separation * sum;
+  j.error = std::min(1.0, 2.0 * sum / d);
+  if (!c.lighting || !(c.adaptation > 0.0)) {
+    j.light = std::numeric_limits<double>::infinity();
+    return j;
+  }
+  const ClusterLight& light = c.lighting->nodes[static_cast<size_t>(y)];
+  const double gap = d - sum;
+  const double irradiance =
+      gap > 0.0 ? std::min(static_cast<double>(light.peak),
+                           static_cast<double>(light.flux) / (std::numbers::pi * gap * gap))
+                : static_cast<double>(light.peak);
+  j.light = static_cast<double>(rx.reflectance) * rx.area * irradiance /
+            (c.adaptation * c.total_area);
+  return j;
+}
+
+// Whether the pair may be one link before its visibility is known.
+bool faint(double light, const ClusterCriterion& c) {
+  return std::isfinite(c.threshold) && light <= c.threshold;
+}
+bool may_link(const Judgement& j, const ClusterCriterion& c) {
+  return !j.too_near && (j.by_distance || faint(j.light * j.error, c));
+}
+
+// What the shadow rays make of a pair that may be one link. Where they are
+// partly blocked, the visible fraction stands for every part of both
+// clusters: a side behind an occluder gets the average. That is taken for a
+// link whose whole light, weighed kShadowWeight times (a shadow in the wrong
+// place is what shows first: the insides of a field of boxes lit through
+// their walls), is below the threshold, or (far enough apart) one ending on a
+// single side, which then sees the emitter cluster's average; otherwise the
+// pair is split, down to pairs of sides, whose links see exactly. None passing says the pair is hidden, which is taken where a
+// mistake would cost little (a reflecting cluster far apart) and otherwise
+// checked the same way: a lamp must not go dark by sixteen unlucky rays.
+constexpr double kShadowWeight = 10.0;
+enum class RayVerdict : std::uint8_t { Link, Hidden, Split };
+RayVerdict ray_verdict(const Judgement& j, const ClusterCriterion& c, float visibility,
+                       bool single_receiver) {
+  if (visibility >= 1.0f) return RayVerdict::Link;
+  if (visibility <= 0.0f) return j.by_distance ? RayVerdict::Hidden : RayVerdict::Split;
+  return faint(kShadowWeight * j.light, c) || (j.by_distance && single_receiver)
+             ? RayVerdict::Link
+             : RayVerdict::Split;
+}
+
+struct Walk {
+  const ClusterTree& tree;
+  const Hierarchy& hierarchy;
+  std::span<const SideSample> sides;
+  const RayScene& scene;
+  const ClusterCriterion& criterion;
+
+  PairOutcome classify(std::int32_t x, std::int32_t y) const;
+};
+
+PairOutcome Walk::classify(std::int32_t x, std::int32_t y) const {
   PairOutcome out;
   const ClusterNode& rx = tree.node(x);
   const ClusterNode& ry = tree.node(y);
@@ -139,24 +228,24 @@ PairOutcome classify(const ClusterTree& tree, const Hierarchy& hierarchy,
     // Facing is judged along the centres' direction only: where the clusters
     // are far apart, a side seen at a grazing angle from part of the other
     // carries little light either way.
-    // Light straight from emitters, the brightest in any scene, always goes
-    // through face links (exact visibility at the receiver's samples).
-    if (!both_leaves && !ry.emits && d > separation * (rx.radius + ry.radius) &&
-        all_facing(ry, w, 0.0) && all_facing(rx, -w, 0.0)) {
-      // A cluster link ends on one side: the distance to the emitter cluster
-      // is then that side's own (a receiving cluster would give the light of
-      // its centre to every side, off by 2 r / d).
-      if (!rx.is_leaf()) return split(PairOutcome::SplitReceiver);
-      const int passed = passing_rays(tree, sides, scene, x, y, rays);
-      if (passed == 0) return out;
-      out.kind = PairOutcome::ClusterPair;
-      out.link.receiver = x;
-      out.link.emitter = y;
-      out.link.direction = {static_cast<float>(w.x), static_cast<float>(w.y),
-                            static_cast<float>(w.z)};
-      out.link.coupling = static_cast<float>(passed) / static_cast<float>(rays) /
-                          static_cast<float>(std::numbers::pi * d * d);
-      return out;
+    const Judgement judgement = judge(rx, ry, y, d, criterion);
+    if (may_link(judgement, criterion) && all_facing(ry, w, 0.0) && all_facing(rx, -w, 0.0)) {
+      const int passed =
+          passing_rays(tree, sides, scene,
+                       criterion.lighting ? std::span<const double>(criterion.lighting->flux_prefix)
+                                          : std::span<const double>(),
+                       x, y, criterion.rays);
+      const float visibility = static_cast<float>(passed) / static_cast<float>(criterion.rays);
+      const RayVerdict verdict = ray_verdict(judgement, criterion, visibility, rx.is_leaf());
+      if (verdict == RayVerdict::Hidden) return out;
+      if (verdict == RayVerdict::Link) {
+        out.kind = PairOutcome::ClusterPair;
+        out.link.receiver = x;
+        out.link.emitter = y;
+        out.link.visibility = visibility;
+        out.link.extent = static_cast<float>(extent_correction(rx, ry));
+        return out;
+      }
     }
   }
   if (both_leaves) {
@@ -175,10 +264,6 @@ PairOutcome classify(const ClusterTree& tree, const Hierarchy& hierarchy,
                    ? PairOutcome::SplitReceiver
                    : PairOutcome::SplitEmitter);
 }
-
-}  // namespace
-
-namespace {
 
 void append(InitialLinks& to, const PairOutcome& o) {
   if (o.kind == PairOutcome::ClusterPair) {
@@ -212,39 +297,32 @@ int children(const ClusterTree& tree, const PairOutcome& o, std::int32_t x, std:
   return n;
 }
 
-}  // namespace
+using Pair = std::pair<std::int32_t, std::int32_t>;
 
-InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy,
-                           const RayScene& scene, double separation, int rays,
-                           const std::function<bool()>& cancelled,
-                           const std::function<void(double)>& progress) {
-  InitialLinks links;
-  if (tree.root() == kNone) return links;
-  using Pair = std::pair<std::int32_t, std::int32_t>;
-  const std::vector<SideSample> sides = side_samples(tree, hierarchy);
-  const auto classify_pair = [&](const Pair& p) {
-    return classify(tree, hierarchy, sides, scene, separation, rays, p.first, p.second);
-  };
-  // Breadth first until there are enough pairs to share between threads, then
-  // each pair's subtree depth first (memory stays that of one path per
-  // thread), each into its own lists, joined in pair order: the links do not
-  // depend on the thread count.
-  // Cancellation (and the time budget) is checked every kCheckEvery pairs a
-  // thread classifies: one pair's subtree can hold millions of pairs.
+// The walk from `start`: breadth first until there are enough pairs to share
+// between threads (when `widen`), then each pair's subtree depth first
+// (memory stays that of one path per thread), each into its own lists, joined
+// in pair order: the links do not depend on the thread count. Cancellation
+// (and the time budget) is checked every kCheckEvery pairs a thread
+// classifies: one pair's subtree can hold millions of pairs.
+InitialLinks walk_from(const Walk& walk, std::vector<Pair> frontier, bool widen,
+                       const std::function<bool()>& cancelled,
+                       const std::function<void(double)>& progress) {
   constexpr int kCheckEvery = 4096;
+  constexpr size_t kWide = 4096;
+  InitialLinks links;
   std::atomic<bool> stop{false};
   const auto should_stop = [&] {
     if (!stop.load(std::memory_order_relaxed) && cancelled && cancelled()) stop = true;
     return stop.load(std::memory_order_relaxed);
   };
-  std::vector<Pair> frontier{{tree.root(), tree.root()}};
-  while (!frontier.empty() && frontier.size() < 4096 && !should_stop()) {
+  while (widen && !frontier.empty() && frontier.size() < kWide && !should_stop()) {
     std::vector<Pair> next;
     for (const Pair& p : frontier) {
-      const PairOutcome o = classify_pair(p);
+      const PairOutcome o = walk.classify(p.first, p.second);
       append(links, o);
       Pair made[4];
-      const int n = children(tree, o, p.first, p.second, made);
+      const int n = children(walk.tree, o, p.first, p.second, made);
       next.insert(next.end(), made, made + n);
     }
     frontier = std::move(next);
@@ -265,10 +343,10 @@ InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy,
           }
           const Pair p = stack.back();
           stack.pop_back();
-          const PairOutcome o = classify_pair(p);
+          const PairOutcome o = walk.classify(p.first, p.second);
           append(found[i], o);
           Pair made[4];
-          const int n = children(tree, o, p.first, p.second, made);
+          const int n = children(walk.tree, o, p.first, p.second, made);
           for (int k = n; k-- > 0;) stack.push_back(made[k]);  // first child on top: visited first
         }
       }
@@ -283,11 +361,132 @@ InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy,
   return links;
 }
 
+}  // namespace
+
+double extent_correction(const ClusterNode& receiver, const ClusterNode& emitter) {
+  const dvec3 r = receiver.centre - emitter.centre;
+  const dvec3 u = emitter.axis, v = receiver.axis;
+  const double rho2 = glm::dot(r, r), p = glm::dot(u, r), q = glm::dot(v, r);
+  const double kernel = -p * q / (std::numbers::pi * rho2 * rho2);
+  if (!(kernel > 0.0)) return 1.0;
+  const dvec3 w = q * u + p * v;
+  const glm::dmat3 hessian =
+      (-(glm::outerProduct(u, v) + glm::outerProduct(v, u)) / (rho2 * rho2) +
+       4.0 * (glm::outerProduct(w, r) + glm::outerProduct(r, w)) / (rho2 * rho2 * rho2) +
+       4.0 * p * q * glm::dmat3(1.0) / (rho2 * rho2 * rho2) -
+       24.0 * p * q * glm::outerProduct(r, r) / (rho2 * rho2 * rho2 * rho2)) /
+      std::numbers::pi;
+  const glm::dmat3 spread = receiver.covariance_matrix() + emitter.covariance_matrix();
+  double trace = 0.0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) trace += hessian[i][j] * spread[j][i];
+  // Beyond a factor of two the expansion is no guide (clusters this near are never linked).
+  return std::clamp(1.0 + 0.5 * trace / kernel, 0.5, 2.0);
+}
+
+namespace {
+
+// The light of every node from each side's luminance (`sent(element)`).
+template <typename Sent>
+ClusterLighting lighting_of(const ClusterTree& tree, const Hierarchy& hierarchy, const Sent& sent) {
+  const auto& nodes = tree.nodes();
+  ClusterLighting out;
+  out.nodes.resize(nodes.size());
+  out.flux_prefix.assign(tree.sides().size() + 1, 0.0);
+  for (size_t i = 0; i < tree.sides().size(); ++i) {
+    const std::int32_t side = tree.sides()[i];
+    out.flux_prefix[i + 1] = out.flux_prefix[i] + sent(side) * hierarchy.element(side).area;
+  }
+  for (size_t i = nodes.size(); i-- > 0;) {  // children come after their parent
+    const ClusterNode& node = nodes[i];
+    ClusterLight& l = out.nodes[i];
+    if (node.is_leaf()) {
+      const double luminance = sent(tree.sides()[node.first]);
+      l = {static_cast<float>(out.flux_prefix[node.first + 1] - out.flux_prefix[node.first]),
+           static_cast<float>(luminance)};
+    } else {
+      const ClusterLight& a = out.nodes[static_cast<size_t>(node.child[0])];
+      const ClusterLight& b = out.nodes[static_cast<size_t>(node.child[1])];
+      l = {a.flux + b.flux, std::max(a.peak, b.peak)};
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+ClusterLighting estimated_cluster_light(const ClusterTree& tree, const Hierarchy& hierarchy,
+                                       double radiance) {
+  return lighting_of(tree, hierarchy, [&](std::int32_t side) {
+    const Element& e = hierarchy.element(side);
+    const double emitted = luminance(hierarchy.emission(e));
+    return emitted > 0.0 ? emitted : luminance(hierarchy.reflectance(e)) * radiance;
+  });
+}
+
+InitialLinks link_clusters(const ClusterTree& tree, const Hierarchy& hierarchy,
+                           const RayScene& scene, const ClusterCriterion& criterion,
+                           const std::function<bool()>& cancelled,
+                           const std::function<void(double)>& progress) {
+  if (tree.root() == kNone) return {};
+  const std::vector<SideSample> sides = side_samples(tree, hierarchy);
+  const Walk walk{tree, hierarchy, sides, scene, criterion};
+  return walk_from(walk, {{tree.root(), tree.root()}}, true, cancelled, progress);
+}
+
+bool cluster_link_too_coarse(const ClusterTree& tree, const Hierarchy&, const ClusterLink& link,
+                             const ClusterCriterion& criterion) {
+  const ClusterNode& rx = tree.node(link.receiver);
+  const ClusterNode& ry = tree.node(link.emitter);
+  const Judgement j = judge(rx, ry, link.emitter, glm::length(rx.centre - ry.centre), criterion);
+  return !may_link(j, criterion) ||
+         ray_verdict(j, criterion, link.visibility, rx.is_leaf()) != RayVerdict::Link;
+}
+
+InitialLinks split_cluster_links(const ClusterTree& tree, const Hierarchy& hierarchy,
+                                 const RayScene& scene, const ClusterCriterion& criterion,
+                                 std::span<const ClusterLink> links,
+                                 const std::function<bool()>& cancelled) {
+  if (links.empty()) return {};
+  const std::vector<SideSample> sides = side_samples(tree, hierarchy);
+  const Walk walk{tree, hierarchy, sides, scene, criterion};
+  // The criterion no longer takes the pair: walking from it splits it.
+  std::vector<Pair> start;
+  start.reserve(links.size());
+  for (const ClusterLink& l : links) start.emplace_back(l.receiver, l.emitter);
+  return walk_from(walk, std::move(start), false, cancelled, {});
+}
+
+void mark_cluster_receivers(const ClusterTree& tree, std::span<const ClusterLink> links,
+                            std::vector<std::uint8_t>& mark) {
+  const auto& nodes = tree.nodes();
+  std::vector<std::uint8_t> receives(nodes.size(), 0);
+  for (const ClusterLink& l : links) receives[static_cast<size_t>(l.receiver)] = 1;
+  for (size_t i = 0; i < nodes.size(); ++i) {  // parents before children
+    const ClusterNode& node = nodes[i];
+    if (!receives[i]) continue;
+    if (node.is_leaf()) {
+      mark[static_cast<size_t>(tree.sides()[node.first])] = 1;
+    } else {
+      for (std::int32_t c : node.child) receives[static_cast<size_t>(c)] = 1;
+    }
+  }
+}
+
+void sort_by_receiver(std::vector<ClusterLink>& links) {
+  std::sort(links.begin(), links.end(), [](const ClusterLink& a, const ClusterLink& b) {
+    return a.receiver < b.receiver || (a.receiver == b.receiver && a.emitter < b.emitter);
+  });
+}
+
 void ClusterGather::operator()(const ClusterTree& tree, const std::vector<ClusterLink>& links,
                                const Hierarchy& hierarchy, const std::vector<Rgb>& radiance,
-                               std::vector<Rgb>& gathered) {
+                               std::vector<SampleRgb>& gathered) {
   const auto& nodes = tree.nodes();
   power_.assign(nodes.size(), ChannelVectors{});
+  lighting_ = lighting_of(tree, hierarchy, [&](std::int32_t side) {
+    return std::max(0.0, luminance(radiance[static_cast<size_t>(side)]));
+  });
   // Power vectors, leaves up (children come after their parent).
   for (size_t i = nodes.size(); i-- > 0;) {
     const ClusterNode& node = nodes[i];
@@ -299,25 +498,80 @@ void ClusterGather::operator()(const ClusterTree& tree, const std::vector<Cluste
       const dvec3 n = e.area * hierarchy.normal(e);
       p = {l.x * n, l.y * n, l.z * n};
     } else {
-      for (int c = 0; c < 3; ++c)
-        p[static_cast<size_t>(c)] =
-            power_[static_cast<size_t>(node.child[0])][static_cast<size_t>(c)] +
-            power_[static_cast<size_t>(node.child[1])][static_cast<size_t>(c)];
+      const auto a = static_cast<size_t>(node.child[0]), b = static_cast<size_t>(node.child[1]);
+      for (size_t c = 0; c < 3; ++c) p[c] = power_[a][c] + power_[b][c];
     }
   }
-  // Each link: the emitter's intensity towards the receiving side, taken
-  // through that side's own normal.
-  gathered.assign(gathered.size(), Rgb(0.0));
-  for (const ClusterLink& link : links) {
-    const dvec3 w(link.direction[0], link.direction[1], link.direction[2]);
-    const ChannelVectors& p = power_[static_cast<size_t>(link.emitter)];
-    const std::int32_t side = tree.sides()[tree.node(link.receiver).first];
-    const double cosine = std::max(0.0, -glm::dot(hierarchy.normal(hierarchy.element(side)), w));
-    Rgb& g = gathered[static_cast<size_t>(side)];
-    for (int c = 0; c < 3; ++c)
-      g[c] += static_cast<double>(link.coupling) * cosine *
-              std::max(0.0, glm::dot(p[static_cast<size_t>(c)], w));
+  // Each receiving cluster's S and G from its links (runs of one receiver, in parallel).
+  received_.assign(nodes.size(), Received{});
+  std::vector<size_t> runs;
+  for (size_t i = 0; i < links.size(); ++i)
+    if (i == 0 || links[i].receiver != links[i - 1].receiver) runs.push_back(i);
+  runs.push_back(links.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, runs.size() - 1), [&](const auto& range) {
+    for (size_t k = range.begin(); k != range.end(); ++k) {
+      Received& to = received_[static_cast<size_t>(links[runs[k]].receiver)];
+      glm::dmat3 change[3] = {glm::dmat3(0.0), glm::dmat3(0.0), glm::dmat3(0.0)};
+      for (size_t i = runs[k]; i < runs[k + 1]; ++i) {
+        const ClusterLink& link = links[i];
+        const dvec3 r = tree.node(link.receiver).centre - tree.node(link.emitter).centre;
+        const double d2 = glm::dot(r, r);
+        const double k4 = link.transfer() / (std::numbers::pi * d2 * d2);
+        const ChannelVectors& p = power_[static_cast<size_t>(link.emitter)];
+        for (size_t c = 0; c < 3; ++c) {
+          const double pr = glm::dot(p[c], r);
+          // H = -k4 (P . r)(n . r); its change with x at fixed n (see the header).
+          to.at_centre[c] -= k4 * pr * r;
+          change[c] += k4 * (4.0 * pr / d2 * glm::outerProduct(r, r) - glm::outerProduct(r, p[c]) -
+                             pr * glm::dmat3(1.0));
+        }
+      }
+      for (size_t c = 0; c < 3; ++c) to.change[c] = glm::mat3(change[c]);
+    }
+  });
+  // Down the tree: each child reads its parent's field at its own centre.
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    const ClusterNode& node = nodes[i];
+    if (node.is_leaf()) continue;
+    const Received& from = received_[i];
+    for (std::int32_t child : node.child) {
+      Received& to = received_[static_cast<size_t>(child)];
+      const dvec3 offset = tree.node(child).centre - node.centre;
+      for (size_t c = 0; c < 3; ++c) {
+        to.at_centre[c] += from.at_centre[c] + dvec3(from.change[c] * glm::vec3(offset));
+        to.change[c] += from.change[c];
+      }
+    }
   }
+  // Each side at its samples, through its own normal.
+  gathered.assign(hierarchy.root_count(), SampleRgb{});
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nodes.size()), [&](const auto& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      const ClusterNode& node = nodes[i];
+      if (!node.is_leaf()) continue;
+      const Received& field = received_[i];
+      const std::int32_t side = tree.sides()[node.first];
+      const Element& e = hierarchy.element(side);
+      const dvec3 n = hierarchy.normal(e);
+      dvec3 at[kMaxSamples];
+      const int count = hierarchy.samples(e, at);
+      SampleRgb& out = gathered[static_cast<size_t>(side)];
+      for (int s = 0; s < count; ++s) {
+        const glm::vec3 offset(at[s] - node.centre);
+        for (int c = 0; c < 3; ++c) {
+          const double h = glm::dot(n, field.at_centre[static_cast<size_t>(c)]) +
+                           glm::dot(glm::vec3(n), field.change[static_cast<size_t>(c)] * offset);
+          out[static_cast<size_t>(s)][c] = std::max(0.0, h);
+        }
+      }
+    }
+  });
+}
+
+std::size_t ClusterGather::memory_bytes() const {
+  return power_.capacity() * sizeof(ChannelVectors) +
+         lighting_.nodes.capacity() * sizeof(ClusterLight) +
+         lighting_.flux_prefix.capacity() * sizeof(double) + received_.capacity() * sizeof(Received);
 }
 
 }  // namespace radiosity

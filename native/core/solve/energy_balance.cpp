@@ -4,6 +4,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 
 #include "core/hierarchy/emitter_shape.h"
 
@@ -59,17 +61,20 @@ std::vector<double> delivered_fractions(const Hierarchy& h, const std::vector<Li
     }
   }
   if (!far.empty()) {
-    // A cluster link delivers to its receiving side r from each side q of the
-    // emitter cluster coupling (n_q . w) (-n_r . w) A_q per unit radiance:
-    // per unit area of q that is n_q . V, V summed down the cluster tree.
+    // A cluster link delivers to its receiving cluster X from each side q of
+    // the emitter cluster V (n_q . w) A_q (-N_X . w) / (pi d^2) per unit
+    // radiance, N_X = sum of A n over X (every side of X faces the emitter):
+    // per unit area of q that is n_q . v, v summed down the emitter's tree.
     const auto& nodes = tree.nodes();
     std::vector<dvec3> v(nodes.size(), dvec3(0.0));
     for (const ClusterLink& link : far) {
-      const dvec3 w(link.direction[0], link.direction[1], link.direction[2]);
-      const Element& r = h.element(tree.sides()[tree.node(link.receiver).first]);
-      const double cosine = std::max(0.0, -glm::dot(h.normal(r), w));
+      const ClusterNode& x = tree.node(link.receiver);
+      const dvec3 between = x.centre - tree.node(link.emitter).centre;
+      const double d2 = glm::dot(between, between);
+      const dvec3 w = between / std::sqrt(d2);
+      const double received = std::max(0.0, -glm::dot(x.area_normal, w));
       v[static_cast<size_t>(link.emitter)] +=
-          static_cast<double>(link.coupling) * cosine * r.area * w;
+          link.transfer() / (std::numbers::pi * d2) * received * w;
     }
     for (size_t i = 0; i < nodes.size(); ++i) {
       const ClusterNode& node = nodes[i];
@@ -77,11 +82,8 @@ std::vector<double> delivered_fractions(const Hierarchy& h, const std::vector<Li
         for (std::int32_t c : node.child) v[static_cast<size_t>(c)] += v[i];
         continue;
       }
-      for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
-        const std::int32_t side = tree.sides()[k];
-        delivered[static_cast<size_t>(side)] +=
-            std::max(0.0, glm::dot(h.normal(h.element(side)), v[i]));
-      }
+      const std::int32_t side = tree.sides()[node.first];
+      delivered[static_cast<size_t>(side)] += std::max(0.0, glm::dot(h.normal(h.element(side)), v[i]));
     }
   }
   // Parents come before their children.
@@ -124,11 +126,8 @@ void EnergyBalance::update(const Hierarchy& h, const LinkGather& grouping, const
   for (size_t e = 0; e < n; ++e) partners[e] = Rgb(1.0, reflects(h, elements[e]) ? 1.0 : 0.0, 0.0);
   const LinkGather coverage{grouping.hierarchy, grouping.links, grouping.offset, grouping.order,
                             partners};
-  std::vector<Rgb> far_coverage;
-  if (!far.empty()) {
-    far_coverage.resize(h.root_count());
-    far_gather(tree, far, h, partners, far_coverage);
-  }
+  std::vector<SampleRgb> far_coverage;
+  if (!far.empty()) far_gather(tree, far, h, partners, far_coverage);
   const std::vector<SampleRgb> at_leaves = gathered_at_leaves(h, coverage, far_coverage);
 
   // Closure of new elements: from the links for top-level ones (first update,

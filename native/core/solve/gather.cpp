@@ -53,10 +53,8 @@ void for_each_root(const Hierarchy& h, const Visit& visit) {
   });
 }
 
-SampleRgb far_down(const std::vector<Rgb>& far_light, std::int32_t root) {
-  SampleRgb down{};
-  if (!far_light.empty()) down.fill(far_light[static_cast<size_t>(root)]);
-  return down;
+SampleRgb far_down(const std::vector<SampleRgb>& far_light, std::int32_t root) {
+  return far_light.empty() ? SampleRgb{} : far_light[static_cast<size_t>(root)];
 }
 
 void gather_down(const Hierarchy& h, std::int32_t index, const SampleRgb& down,
@@ -122,7 +120,7 @@ Rgb PushPull::operator()(std::int32_t index, const SampleRgb& down, Change& chan
 }  // namespace
 
 std::vector<SampleRgb> gathered_at_leaves(const Hierarchy& h, const LinkGather& gather,
-                                          const std::vector<Rgb>& far_light) {
+                                          const std::vector<SampleRgb>& far_light) {
   std::vector<SampleRgb> out(h.elements().size());
   for_each_root(h, [&](size_t, std::int32_t root) {
     gather_down(h, root, far_down(far_light, root), gather, out);
@@ -130,7 +128,7 @@ std::vector<SampleRgb> gathered_at_leaves(const Hierarchy& h, const LinkGather& 
   return out;
 }
 
-double push_pull(Hierarchy& h, const LinkGather& gather, const std::vector<Rgb>& far_light,
+double push_pull(Hierarchy& h, const LinkGather& gather, const std::vector<SampleRgb>& far_light,
                  const std::vector<SampleScale>& down_scale, const std::vector<SampleRgb>& direct,
                  std::vector<SampleRgb>* leaf_out) {
   std::vector<Change> changes(h.root_count());

@@ -38,10 +38,10 @@ std::array<SampleRgb, 4> push_to_children(const Hierarchy& hierarchy, const Elem
 
 // What every leaf gathers at its samples, its own links plus everything its
 // ancestors gathered pushed down, without touching radiances. `far_light`:
-// what each top-level element gathers through cluster links, uniform over
-// it (or empty). Indexed by element; zero for inner elements.
+// what each top-level element gathers through cluster links, at its samples
+// (or empty). Indexed by element; zero for inner elements.
 std::vector<SampleRgb> gathered_at_leaves(const Hierarchy& hierarchy, const LinkGather& gather,
-                                          const std::vector<Rgb>& far_light);
+                                          const std::vector<SampleRgb>& far_light);
 
 // One push/pull over every root: each leaf's radiance becomes L_e + rho H
 // (H the interpolant's average of what it gathered), each inner element's the
@@ -52,7 +52,8 @@ std::vector<SampleRgb> gathered_at_leaves(const Hierarchy& hierarchy, const Link
 // lights that are not surfaces (direct_light.h), at its samples.
 // `leaf_out`, if given, receives what each leaf gathered at its samples (for
 // the output mesh).
-double push_pull(Hierarchy& hierarchy, const LinkGather& gather, const std::vector<Rgb>& far_light,
+double push_pull(Hierarchy& hierarchy, const LinkGather& gather,
+                 const std::vector<SampleRgb>& far_light,
                  const std::vector<SampleScale>& down_scale, const std::vector<SampleRgb>& direct,
                  std::vector<SampleRgb>* leaf_out = nullptr);
 

@@ -37,6 +37,11 @@ struct ThresholdRange {
   double coarse, fine;
 };
 
+// Quality 0 to 1 onto the range, log-linearly.
+double log_interpolate(const ThresholdRange& range, double quality) {
+  return range.coarse * std::pow(range.fine / range.coarse, std::clamp(quality, 0.0, 1.0));
+}
+
 ThresholdRange threshold_range(Oracle oracle) {
   switch (oracle) {
     case Oracle::Standard:
@@ -54,9 +59,15 @@ ThresholdRange threshold_range(Oracle oracle) {
 // Far enough apart for a cluster link: the emitter cluster's light is taken
 // as if it left from its centroid, which errs more the larger it looks from
 // the receiver, so finer quality asks for more distance.
-double cluster_separation(const SolveOptions& options) {
-  return options.cluster_separation > 0.0 ? options.cluster_separation
-                                          : 2.0 + 8.0 * options.quality;
+double cluster_separation(const SolveOptions& options, double quality) {
+  return options.cluster_separation > 0.0 ? options.cluster_separation : 2.0 + 8.0 * quality;
+}
+
+// The error in power a cluster link may make, relative to the adaptation
+// radiance times the total area: the standard oracle's scale (what a link's
+// light varies by over its receiver), finite at quality 0.
+double cluster_threshold(double quality) {
+  return log_interpolate(threshold_range(Oracle::Standard), quality);
 }
 
 // Radiance change since the last refinement when not known: refine first.
@@ -132,7 +143,12 @@ class Solver {
 
   void report(SolvePhase phase, double fraction, const SolveResult* pass_result = nullptr);
   double pass_fraction(double within) const;
-  std::vector<double> pass_thresholds() const;
+  // Quality of each pass, coarse to fine (pass 0 refines nothing: quality 0).
+  std::vector<double> pass_qualities() const;
+  ClusterCriterion cluster_criterion(double quality, const ClusterLighting& lighting,
+                                     double adaptation) const;
+  bool refine_cluster_links();
+  void mark_cluster_receivers_linked();
   void count(SolveStats& stats) const;
   void link_initially();
   void drop_links_light_cannot_reach();
@@ -173,7 +189,8 @@ class Solver {
   ClusterTree clusters_;
   std::vector<ClusterLink> cluster_links_;
   ClusterGather cluster_gather_;
-  std::vector<Rgb> far_light_;  // what each top-level element gathers through cluster links
+  // What each top-level element gathers through cluster links, at its samples.
+  std::vector<SampleRgb> far_light_;
   // Light from the lights that are not surfaces: one link per leaf and light
   // that reaches it, and what each element gathers from them at its samples.
   std::vector<LightLink> light_links_;
@@ -185,7 +202,7 @@ class Solver {
   bool memory_hit_ = false;
   bool cut_short_ = false;             // the last evaluate_links stopped before the end
   bool refinement_cut_short_ = false;  // ... within refine(): the pass is abandoned
-  std::vector<double> thresholds_;     // one per pass (pass_thresholds)
+  std::vector<double> qualities_;      // one per pass (pass_qualities)
   int pass_ = 0, passes_ = 1;
   double fraction_ = 0.0;  // the last reported: progress never goes back
   double threshold_ = std::numeric_limits<double>::infinity();
@@ -227,7 +244,7 @@ double Solver::pass_fraction(double within) const { return 0.1 + 0.9 * (pass_ + 
 void Solver::track_memory() {
   stats_.element_bytes = hierarchy_.memory_bytes() + offset_.capacity() * sizeof(std::uint32_t) +
                          source_.capacity() * sizeof(Rgb) + clusters_.memory_bytes() +
-                         cluster_gather_.memory_bytes() + far_light_.capacity() * sizeof(Rgb) +
+                         cluster_gather_.memory_bytes() + far_light_.capacity() * sizeof(SampleRgb) +
                          balance_.memory_bytes() + direct_light_.capacity() * sizeof(SampleRgb);
   stats_.link_bytes = links_.capacity() * sizeof(Link) + order_.capacity() * sizeof(std::uint32_t) +
                       cluster_links_.capacity() * sizeof(ClusterLink) +
@@ -255,8 +272,13 @@ std::vector<Link> Solver::evaluate(std::vector<Link>&& candidates) {
 void Solver::link_initially() {
   const auto start = Clock::now();
   // Progress: the walk is the first half of linking, evaluating face links the second.
+  // The first pass's links (quality 0): reflecting clusters by distance,
+  // emitters by the light a guess of the solution says they carry.
+  const ClusterLighting guess =
+      estimated_cluster_light(clusters_, hierarchy_, scene_.reference_radiance());
   InitialLinks initial = link_clusters(
-      clusters_, hierarchy_, *occluders_.rays, cluster_separation(options_), kClusterRays,
+      clusters_, hierarchy_, *occluders_.rays,
+      cluster_criterion(qualities_.front(), guess, scene_.reference_radiance()),
       [this] { return cancelled() || out_of_time(); },
       [this](double done) { report(SolvePhase::Linking, 0.05 * done); });
   stats_.seconds_clustering = seconds_since(start);
@@ -275,17 +297,14 @@ void Solver::link_initially() {
   }
   candidates = {};
   cluster_links_ = std::move(initial.clusters);
+  sort_by_receiver(cluster_links_);
   cluster_links_.shrink_to_fit();
   if (!scene_.lights.empty() && !cancelled()) {
     light_links_ = evaluate_light_links(direct_, direct_.initial_links());
     ++light_version_;
   }
   drop_links_light_cannot_reach();
-  for (const ClusterLink& l : cluster_links_) {
-    const ClusterNode& node = clusters_.node(l.receiver);
-    for (std::uint32_t i = node.first; i < node.first + node.count; ++i)
-      hierarchy_.element(clusters_.sides()[i]).has_links = 1;
-  }
+  mark_cluster_receivers_linked();
   if (cluster_links_.empty()) clusters_.release();
   for (const Link& l : links_) hierarchy_.element(l.receiver).has_links = 1;
   for (const LightLink& l : light_links_) hierarchy_.element(l.receiver).has_links = 1;
@@ -313,11 +332,7 @@ void Solver::drop_links_light_cannot_reach() {
       reached[static_cast<size_t>(root)] = 1;
   }
   for (const LightLink& l : light_links_) reached[static_cast<size_t>(l.receiver)] = 1;
-  for (const ClusterLink& l : cluster_links_) {
-    const ClusterNode& node = clusters_.node(l.receiver);
-    for (std::uint32_t i = node.first; i < node.first + node.count; ++i)
-      reached[static_cast<size_t>(clusters_.sides()[i])] = 1;
-  }
+  mark_cluster_receivers(clusters_, cluster_links_, reached);
   for (bool spread = true; spread;) {
     spread = false;
     for (const Link& l : links_) {
@@ -330,12 +345,57 @@ void Solver::drop_links_light_cannot_reach() {
   std::erase_if(links_, [&](const Link& l) { return !reached[static_cast<size_t>(l.receiver)]; });
 }
 
+// Every top-level element under a receiving cluster has links.
+void Solver::mark_cluster_receivers_linked() {
+  std::vector<std::uint8_t> marked(hierarchy_.root_count(), 0);
+  mark_cluster_receivers(clusters_, cluster_links_, marked);
+  for (size_t e = 0; e < marked.size(); ++e)
+    if (marked[e]) hierarchy_.element(static_cast<std::int32_t>(e)).has_links = 1;
+}
+
+// Cluster links the pass's criterion no longer accepts, with the light the
+// clusters send now, are replaced by the walk from them (cluster_links.h):
+// finer cluster links, and links between top-level elements, evaluated here.
+// Returns whether anything changed.
+bool Solver::refine_cluster_links() {
+  if (cluster_links_.empty()) return false;
+  const ClusterCriterion criterion =
+      cluster_criterion(qualities_[static_cast<size_t>(pass_)], cluster_gather_.lighting(),
+                        decision_scale_.adaptation);
+  if (criterion.lighting->nodes.size() != clusters_.nodes().size()) return false;  // not gathered
+  std::vector<ClusterLink> coarse, kept;
+  for (const ClusterLink& l : cluster_links_)
+    (cluster_link_too_coarse(clusters_, hierarchy_, l, criterion) ? coarse : kept).push_back(l);
+  if (coarse.empty()) return false;
+  InitialLinks finer = split_cluster_links(clusters_, hierarchy_, *occluders_.rays, criterion,
+                                           coarse, [this] { return cancelled() || out_of_time(); });
+  if (cancelled() || out_of_time()) {  // a partial walk is discarded with the pass
+    refinement_cut_short_ = true;
+    return true;
+  }
+  std::vector<Link> made = evaluate(std::move(finer.elements));
+  if (cut_short_) {
+    refinement_cut_short_ = true;
+    return true;
+  }
+  for (const Link& l : made) hierarchy_.element(l.receiver).has_links = 1;
+  links_.insert(links_.end(), made.begin(), made.end());
+  kept.insert(kept.end(), finer.clusters.begin(), finer.clusters.end());
+  sort_by_receiver(kept);
+  cluster_links_ = std::move(kept);
+  mark_cluster_receivers_linked();
+  ++links_version_;
+  track_memory();
+  return true;
+}
+
 // Refines every link above the threshold (refine.h), repeatedly, until none
 // is, evaluating the new links. Returns whether anything changed.
 bool Solver::refine(double threshold) {
   if (!std::isfinite(threshold)) return false;
   decision_scale_ = DecisionScale{options_.oracle, adaptation_radiance(hierarchy_)};
-  bool changed = false;
+  bool changed = refine_cluster_links();
+  if (refinement_cut_short_) return changed;
   while (!cancelled() && !budget_hit_ && !out_of_time()) {
     if (over_memory()) {
       budget_hit_ = memory_hit_ = true;
@@ -438,8 +498,6 @@ void Solver::group_links() {
 
 void Solver::gather_far_light() {
   if (cluster_links_.empty()) return;
-  far_light_.resize(static_cast<size_t>(scene_.patches.size()) *
-                    2);  // top-level elements come first
   cluster_gather_(clusters_, cluster_links_, hierarchy_, source_, far_light_);
 }
 
@@ -504,19 +562,33 @@ void Solver::snapshot(double threshold) {
   count(stats_);
 }
 
-// Threshold of each pass: pass 0 solves without refinement, later passes
-// lower the threshold geometrically to the target. Fixed bounces: one pass.
-std::vector<double> Solver::pass_thresholds() const {
-  const double target = quality_threshold(options_.oracle, options_.quality);
-  if (options_.bounces) return {target};
-  std::vector<double> thresholds = {std::numeric_limits<double>::infinity()};
-  if (std::isfinite(target)) {
+// Pass 0 solves without refinement (quality 0: the coarsest links), later
+// passes raise the quality, and so lower the thresholds geometrically, to the
+// target. Fixed bounces: one pass.
+std::vector<double> Solver::pass_qualities() const {
+  if (options_.bounces) return {options_.quality};
+  std::vector<double> qualities = {0.0};
+  if (options_.quality > 0.0) {
     const int steps = std::max(1, static_cast<int>(std::ceil(6 * options_.quality)));
-    for (int k = 1; k <= steps; ++k) {
-      thresholds.push_back(quality_threshold(options_.oracle, options_.quality * k / steps));
-    }
+    for (int k = 1; k <= steps; ++k) qualities.push_back(options_.quality * k / steps);
   }
-  return thresholds;
+  return qualities;
+}
+
+// What a cluster link must satisfy at `quality` (cluster_links.h), with the
+// light each cluster sends and the adaptation radiance as they stand.
+ClusterCriterion Solver::cluster_criterion(double quality, const ClusterLighting& lighting,
+                                           double adaptation) const {
+  ClusterCriterion c;
+  c.separation = cluster_separation(options_, quality);
+  // An infinite separation asks for pairs of sides only.
+  c.threshold = std::isinf(c.separation) ? std::numeric_limits<double>::infinity()
+                                         : cluster_threshold(quality);
+  c.adaptation = adaptation;
+  c.total_area = scene_.total_area;
+  c.lighting = &lighting;
+  c.rays = kClusterRays;
+  return c;
 }
 
 // The counts of the solution as it stands.
@@ -552,8 +624,8 @@ void Solver::begin(const SolveOptions& options, const ProgressCallback& progress
 
 SolveResult Solver::run(const ProgressCallback& progress, const CancelCheck& cancel) {
   begin(options_, progress, cancel);
-  thresholds_ = pass_thresholds();
-  passes_ = static_cast<int>(thresholds_.size());
+  qualities_ = pass_qualities();
+  passes_ = static_cast<int>(qualities_.size());
   report(SolvePhase::Linking, 0.0);
   link_initially();
   if (!cancelled()) snapshot(std::numeric_limits<double>::infinity());  // emitters only
@@ -567,7 +639,7 @@ SolveResult Solver::relight(const SolveOptions& options, double scale,
   stats_.reused = true;
   // One pass at the target threshold: the kept solution already passed the
   // coarser ones, with the old radiances as the start.
-  thresholds_ = {pass_thresholds().back()};
+  qualities_ = {pass_qualities().back()};
   passes_ = 1;
   report(SolvePhase::Linking, 0.0);
   // Which sides reflect and what the lights give changed: regroup (the energy
@@ -600,7 +672,7 @@ SolveResult Solver::relight(const SolveOptions& options, double scale,
 void Solver::solve_passes(double drift) {
   for (pass_ = 0; pass_ < passes_; ++pass_) {
     if (cancelled()) break;
-    threshold_ = thresholds_[static_cast<size_t>(pass_)];
+    threshold_ = quality_threshold(options_.oracle, qualities_[static_cast<size_t>(pass_)]);
     const bool last = pass_ + 1 == passes_;
     if (options_.bounces) {
       iterate(threshold_, *options_.bounces, -1.0, drift);
@@ -660,9 +732,7 @@ std::size_t estimated_base_bytes(const Scene& scene) {
 
 double quality_threshold(Oracle oracle, double quality) {
   if (!(quality > 0.0)) return std::numeric_limits<double>::infinity();
-  const ThresholdRange range = threshold_range(oracle);
-  const double q = std::min(quality, 1.0);
-  return range.coarse * std::pow(range.fine / range.coarse, q);
+  return log_interpolate(threshold_range(oracle), quality);
 }
 
 // A complete solve and the scene it was made for (the solver refers to it),
