@@ -284,16 +284,16 @@ def fmt_row(r):
     result = r.get("result", "-")
     if r.get("last_progress") and "exposure" not in r:
         result += "; last progress: " + r["last_progress"]
-    return "| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
-        r["scene"], format(r["triangles"], ",") if r.get("triangles") else "?", quality,
+    return "| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+        r["scene"], format(r["triangles"], ",") if r.get("triangles") else "?", r.get("addon_commit") or "?", quality,
         "%g" % r["time_budget"] if r["time_budget"] else "none", result,
         num("wall_seconds", "%.1f"), num("peak_gb", "%.2f") if r.get("peak_gb") else "(%.2f)" % r["largest_rss_gb"],
         format(r["elements"], ",") if "elements" in r else "-", format(r["links"], ",") if "links" in r else "-",
         num("exposure", "%+.1f %%", 100), num("block", "%.1f %%", 100))
 
 
-HEADER = ["| scene | triangles | quality | time budget s | result | solve s | peak GB | elements | links | exposure "
-          "| median block |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+HEADER = ["| scene | triangles | add-on | quality | time budget s | result | solve s | peak GB | elements | links "
+          "| exposure | median block |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
 
 
 def main():
@@ -347,14 +347,16 @@ def main():
 
 
 def write_results(args, rows):
-    """Merges `rows` into <build>/furnished/results.json (keeping the other scenes, qualities
-    and budgets measured before) and writes the table to results.md."""
+    """Merges `rows` into <build>/furnished/results.json (keeping the other scenes, qualities,
+    budgets and add-on builds measured before) and writes the table to results.md."""
     out = catalog.furnished_dir(args.build)
     defaults = json.loads((pathlib.Path(args.addon_build) / "addon" / "radiosity" / "solver_defaults.json").read_text())
     results = out / "results.json"
-    measured = {(r["scene"], r["quality_asked"], r["time_budget"]): r for r in rows}
+    def key(r):
+        return r["scene"], r["quality_asked"], r["time_budget"], r.get("addon_build"), r.get("addon_commit")
+    measured = {key(r) for r in rows}
     earlier = json.loads(results.read_text())["rows"] if results.exists() else []
-    rows = [r for r in earlier if (r["scene"], r["quality_asked"], r["time_budget"]) not in measured] + rows
+    rows = [r for r in earlier if key(r) not in measured] + rows
     for row in rows:
         if "log" not in row:   # rows of the first version of this script
             logs = sorted((out / "cache").glob("%s_*/solve_q%s_b%g.log" % (row["scene"], row["quality_asked"],
@@ -363,7 +365,7 @@ def write_results(args, rows):
             row["last_progress"] = last_progress(logs[-1]) if logs else None
         row.setdefault("default_quality", defaults["quality"])
     rows.sort(key=lambda r: (list(catalog.SCENES).index(r["scene"]) if r["scene"] in catalog.SCENES else 99,
-                             r["time_budget"], r["quality_asked"]))
+                             r.get("addon_commit") or "", r["time_budget"], r["quality_asked"]))
     table = "\n".join(HEADER + [fmt_row(r) for r in rows])
     print(table)
     results.write_text(json.dumps(dict(rows=rows), indent=1))
@@ -373,9 +375,11 @@ def write_results(args, rows):
 
 def git_commit(build):
     """The commit of the source tree a build tree sits in (its parent), if it is a git checkout."""
-    run = subprocess.run(["git", "-C", str(pathlib.Path(build).parent), "rev-parse", "--short", "HEAD"],
-                         capture_output=True, text=True)
-    return run.stdout.strip() or None
+    tree = str(pathlib.Path(build).parent)
+    run = subprocess.run(["git", "-C", tree, "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
+    changed = subprocess.run(["git", "-C", tree, "status", "--porcelain", "--", "native", "addon"],
+                             capture_output=True, text=True).stdout.strip()
+    return (run.stdout.strip() + (" + uncommitted native/addon changes" if changed else "")) or None
 
 
 if __name__ == "__main__":
