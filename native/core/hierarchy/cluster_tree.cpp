@@ -140,17 +140,29 @@ std::int32_t ClusterTree::build(const Hierarchy& hierarchy, std::uint32_t first,
       }
       half = best;
     } else {
-      dvec3 low(std::numeric_limits<double>::infinity()), high = -low;
+      // Halves along the longest extent of a point in six dimensions: the
+      // side's centre, and its normal times the node's radius (so a curved
+      // or dented surface is cut where its normals turn as readily as where
+      // it runs on: clusters that face one way link as clusters sooner).
+      const auto coordinate = [&](std::int32_t e, int k) {
+        const Element& x = hierarchy.element(e);
+        return k < 3 ? hierarchy.centre(x)[k] : node.radius * hierarchy.normal(x)[k - 3];
+      };
+      double low[6], high[6];
+      std::fill(low, low + 6, std::numeric_limits<double>::infinity());
+      std::fill(high, high + 6, -std::numeric_limits<double>::infinity());
       for (auto it = begin; it != end; ++it)
-        low = glm::min(low, centre_of(*it)), high = glm::max(high, centre_of(*it));
-      const dvec3 extent = high - low;
-      const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0
-                       : extent.y >= extent.z                       ? 1
-                                                                    : 2;
+        for (int k = 0; k < 6; ++k) {
+          low[k] = std::min(low[k], coordinate(*it, k));
+          high[k] = std::max(high[k], coordinate(*it, k));
+        }
+      int axis = 0;
+      for (int k = 1; k < 6; ++k)
+        if (high[k] - low[k] > high[axis] - low[axis]) axis = k;
       half = count / 2;
       // Ties broken by element id: the tree does not depend on the sort's luck.
       std::nth_element(begin, begin + half, end, [&](std::int32_t a, std::int32_t b) {
-        const double ca = centre_of(a)[axis], cb = centre_of(b)[axis];
+        const double ca = coordinate(a, axis), cb = coordinate(b, axis);
         return ca < cb || (ca == cb && a < b);
       });
     }

@@ -25,6 +25,16 @@ bool none_facing(const ClusterNode& node, const dvec3& w, double cone) {
   return angle - node.spread - cone > 0.5 * std::numbers::pi + 1e-6;
 }
 
+// The area the node's sides show towards w: the sum of A max(0, n . w),
+// from the area-normal sum wherever a node faces w whole (or not at all).
+double facing_area(const ClusterTree& tree, std::int32_t index, const dvec3& w) {
+  const ClusterNode& node = tree.node(index);
+  if (all_facing(node, w, 0.0)) return glm::dot(node.area_normal, w);
+  if (none_facing(node, w, 0.0)) return 0.0;
+  if (node.is_leaf()) return std::max(0.0, glm::dot(node.area_normal, w));
+  return facing_area(tree, node.child[0], w) + facing_area(tree, node.child[1], w);
+}
+
 // Two flat nodes (every side facing along its axis) that cannot exchange
 // light: facing the same way (each side sees only what rises above its own
 // plane, and the other must see it back), or facing opposite ways with no
@@ -229,7 +239,10 @@ PairOutcome Walk::classify(std::int32_t x, std::int32_t y) const {
     // are far apart, a side seen at a grazing angle from part of the other
     // carries little light either way.
     const Judgement judgement = judge(rx, ry, y, d, criterion);
-    if (may_link(judgement, criterion) && all_facing(ry, w, 0.0) && all_facing(rx, -w, 0.0)) {
+    const bool emitter_faces = all_facing(ry, w, 0.0);
+    const bool receiver_faces = all_facing(rx, -w, 0.0);
+    if (may_link(judgement, criterion) &&
+        ((emitter_faces && receiver_faces) || faint(judgement.light, criterion))) {
       const int passed =
           passing_rays(tree, sides, scene,
                        criterion.lighting ? std::span<const double>(criterion.lighting->flux_prefix)
@@ -243,7 +256,16 @@ PairOutcome Walk::classify(std::int32_t x, std::int32_t y) const {
         out.link.receiver = x;
         out.link.emitter = y;
         out.link.visibility = visibility;
-        out.link.extent = static_cast<float>(extent_correction(rx, ry));
+        if (emitter_faces && receiver_faces)
+          out.link.extent = static_cast<float>(extent_correction(rx, ry));
+        if (!emitter_faces) {
+          out.link.isotropic = 1;
+          out.link.shown = static_cast<float>(facing_area(tree, y, w) / ry.area);
+        }
+        if (!receiver_faces) {
+          out.link.spherical = 1;
+          out.link.seen = static_cast<float>(facing_area(tree, x, -w) / rx.area);
+        }
         return out;
       }
     }
@@ -361,6 +383,63 @@ InitialLinks walk_from(const Walk& walk, std::vector<Pair> frontier, bool widen,
   return links;
 }
 
+// The real spherical harmonics of order 0 to 2 at the unit vector n.
+std::array<double, 9> harmonics(const dvec3& n) {
+  return {0.282095,
+          0.488603 * n.y,
+          0.488603 * n.z,
+          0.488603 * n.x,
+          1.092548 * n.x * n.y,
+          1.092548 * n.y * n.z,
+          0.315392 * (3.0 * n.z * n.z - 1.0),
+          1.092548 * n.x * n.z,
+          0.546274 * (n.x * n.x - n.y * n.y)};
+}
+
+// The clamped cosine's coefficients per band (pi, 2 pi / 3, pi / 4), per harmonic.
+constexpr double kBand0 = std::numbers::pi, kBand1 = 2.0 * std::numbers::pi / 3.0,
+                 kBand2 = std::numbers::pi / 4.0;
+constexpr std::array<double, 9> kClampedCosine = {kBand0, kBand1, kBand1, kBand1, kBand2,
+                                                  kBand2, kBand2, kBand2, kBand2};
+
+// An axis-aligned box (empty: lo above hi).
+struct Box {
+  dvec3 lo{std::numeric_limits<double>::infinity()};
+  dvec3 hi{-std::numeric_limits<double>::infinity()};
+  void add(const Box& b) {
+    lo = glm::min(lo, b.lo);
+    hi = glm::max(hi, b.hi);
+  }
+};
+
+// Per cluster node, a box holding every emitter cluster that sends to it or
+// to one of its ancestors through `links`: what a side of it could receive
+// from lies there.
+std::vector<Box> senders(const ClusterTree& tree, std::span<const ClusterLink> links) {
+  const auto& nodes = tree.nodes();
+  std::vector<Box> box(nodes.size());
+  for (const ClusterLink& l : links) {
+    const ClusterNode& y = tree.node(l.emitter);
+    box[static_cast<size_t>(l.receiver)].add({y.centre - dvec3(y.radius), y.centre + dvec3(y.radius)});
+  }
+  for (size_t i = 0; i < nodes.size(); ++i)  // parents before children
+    if (!nodes[i].is_leaf())
+      for (std::int32_t c : nodes[i].child) box[static_cast<size_t>(c)].add(box[i]);
+  return box;
+}
+
+// Does any of the box lie in front of the side's plane? A side in a
+// receiving cluster with every sender behind it (the outside of a ceiling
+// clustered with the inside of the floor) receives nothing, however the
+// cluster's light extrapolates to it.
+bool faces_senders(const Hierarchy& hierarchy, const Element& side, const Box& box) {
+  if (box.lo.x > box.hi.x) return false;
+  const dvec3 n = hierarchy.normal(side);
+  const dvec3 far_corner(n.x > 0.0 ? box.hi.x : box.lo.x, n.y > 0.0 ? box.hi.y : box.lo.y,
+                         n.z > 0.0 ? box.hi.z : box.lo.z);
+  return glm::dot(n, far_corner - hierarchy.centre(side)) > 0.0;
+}
+
 }  // namespace
 
 double extent_correction(const ClusterNode& receiver, const ClusterNode& emitter) {
@@ -440,6 +519,7 @@ bool cluster_link_too_coarse(const ClusterTree& tree, const Hierarchy&, const Cl
   const ClusterNode& ry = tree.node(link.emitter);
   const Judgement j = judge(rx, ry, link.emitter, glm::length(rx.centre - ry.centre), criterion);
   return !may_link(j, criterion) ||
+         ((link.isotropic || link.spherical) && !faint(j.light, criterion)) ||
          ray_verdict(j, criterion, link.visibility, rx.is_leaf()) != RayVerdict::Link;
 }
 
@@ -457,19 +537,14 @@ InitialLinks split_cluster_links(const ClusterTree& tree, const Hierarchy& hiera
   return walk_from(walk, std::move(start), false, cancelled, {});
 }
 
-void mark_cluster_receivers(const ClusterTree& tree, std::span<const ClusterLink> links,
-                            std::vector<std::uint8_t>& mark) {
-  const auto& nodes = tree.nodes();
-  std::vector<std::uint8_t> receives(nodes.size(), 0);
-  for (const ClusterLink& l : links) receives[static_cast<size_t>(l.receiver)] = 1;
-  for (size_t i = 0; i < nodes.size(); ++i) {  // parents before children
-    const ClusterNode& node = nodes[i];
-    if (!receives[i]) continue;
-    if (node.is_leaf()) {
-      mark[static_cast<size_t>(tree.sides()[node.first])] = 1;
-    } else {
-      for (std::int32_t c : node.child) receives[static_cast<size_t>(c)] = 1;
-    }
+void mark_cluster_receivers(const ClusterTree& tree, const Hierarchy& hierarchy,
+                            std::span<const ClusterLink> links, std::vector<std::uint8_t>& mark) {
+  const std::vector<Box> from = senders(tree, links);
+  for (size_t i = 0; i < tree.nodes().size(); ++i) {
+    if (!tree.nodes()[i].is_leaf()) continue;
+    const std::int32_t side = tree.sides()[tree.nodes()[i].first];
+    if (faces_senders(hierarchy, hierarchy.element(side), from[i]))
+      mark[static_cast<size_t>(side)] = 1;
   }
 }
 
@@ -484,6 +559,7 @@ void ClusterGather::operator()(const ClusterTree& tree, const std::vector<Cluste
                                std::vector<SampleRgb>& gathered) {
   const auto& nodes = tree.nodes();
   power_.assign(nodes.size(), ChannelVectors{});
+  flux_.assign(nodes.size(), Rgb(0.0));
   lighting_ = lighting_of(tree, hierarchy, [&](std::int32_t side) {
     return std::max(0.0, luminance(radiance[static_cast<size_t>(side)]));
   });
@@ -497,9 +573,11 @@ void ClusterGather::operator()(const ClusterTree& tree, const std::vector<Cluste
       const Rgb& l = radiance[static_cast<size_t>(side)];
       const dvec3 n = e.area * hierarchy.normal(e);
       p = {l.x * n, l.y * n, l.z * n};
+      flux_[i] = l * e.area;
     } else {
       const auto a = static_cast<size_t>(node.child[0]), b = static_cast<size_t>(node.child[1]);
       for (size_t c = 0; c < 3; ++c) p[c] = power_[a][c] + power_[b][c];
+      flux_[i] = flux_[a] + flux_[b];
     }
   }
   // Each receiving cluster's S and G from its links (runs of one receiver, in parallel).
@@ -517,7 +595,21 @@ void ClusterGather::operator()(const ClusterTree& tree, const std::vector<Cluste
         const dvec3 r = tree.node(link.receiver).centre - tree.node(link.emitter).centre;
         const double d2 = glm::dot(r, r);
         const double k4 = link.transfer() / (std::numbers::pi * d2 * d2);
-        const ChannelVectors& p = power_[static_cast<size_t>(link.emitter)];
+        const Rgb& f = flux_[static_cast<size_t>(link.emitter)];
+        const double shown = static_cast<double>(link.shown) / std::sqrt(d2);
+        const ChannelVectors isotropic{f.x * shown * r, f.y * shown * r, f.z * shown * r};
+        const ChannelVectors& p =
+            link.isotropic ? isotropic : power_[static_cast<size_t>(link.emitter)];
+        if (link.spherical) {
+          // Light from u = -w of H = i (n . u) for a side facing it.
+          const dvec3 u = -r / std::sqrt(d2);
+          const std::array<double, 9> y = harmonics(u);
+          for (size_t c = 0; c < 3; ++c) {
+            const double i = k4 * glm::dot(p[c], r) * std::sqrt(d2);
+            for (size_t m = 0; m < 9; ++m) to.harmonics[c][m] += static_cast<float>(i * y[m]);
+          }
+          continue;
+        }
         for (size_t c = 0; c < 3; ++c) {
           const double pr = glm::dot(p[c], r);
           // H = -k4 (P . r)(n . r); its change with x at fixed n (see the header).
@@ -540,10 +632,12 @@ void ClusterGather::operator()(const ClusterTree& tree, const std::vector<Cluste
       for (size_t c = 0; c < 3; ++c) {
         to.at_centre[c] += from.at_centre[c] + dvec3(from.change[c] * glm::vec3(offset));
         to.change[c] += from.change[c];
+        for (size_t m = 0; m < 9; ++m) to.harmonics[c][m] += from.harmonics[c][m];
       }
     }
   }
   // Each side at its samples, through its own normal.
+  const std::vector<Box> from = senders(tree, links);
   gathered.assign(hierarchy.root_count(), SampleRgb{});
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nodes.size()), [&](const auto& range) {
     for (size_t i = range.begin(); i != range.end(); ++i) {
@@ -552,16 +646,25 @@ void ClusterGather::operator()(const ClusterTree& tree, const std::vector<Cluste
       const Received& field = received_[i];
       const std::int32_t side = tree.sides()[node.first];
       const Element& e = hierarchy.element(side);
+      if (!faces_senders(hierarchy, e, from[i])) continue;
       const dvec3 n = hierarchy.normal(e);
       dvec3 at[kMaxSamples];
       const int count = hierarchy.samples(e, at);
       SampleRgb& out = gathered[static_cast<size_t>(side)];
+      const std::array<double, 9> y = harmonics(n);
+      Rgb spherical(0.0);
+      for (int c = 0; c < 3; ++c) {
+        double e = 0.0;
+        for (size_t m = 0; m < 9; ++m)
+          e += kClampedCosine[m] * static_cast<double>(field.harmonics[static_cast<size_t>(c)][m]) * y[m];
+        spherical[c] = std::max(0.0, e);
+      }
       for (int s = 0; s < count; ++s) {
         const glm::vec3 offset(at[s] - node.centre);
         for (int c = 0; c < 3; ++c) {
           const double h = glm::dot(n, field.at_centre[static_cast<size_t>(c)]) +
                            glm::dot(glm::vec3(n), field.change[static_cast<size_t>(c)] * offset);
-          out[static_cast<size_t>(s)][c] = std::max(0.0, h);
+          out[static_cast<size_t>(s)][c] = std::max(0.0, h) + spherical[c];
         }
       }
     }
@@ -569,7 +672,7 @@ void ClusterGather::operator()(const ClusterTree& tree, const std::vector<Cluste
 }
 
 std::size_t ClusterGather::memory_bytes() const {
-  return power_.capacity() * sizeof(ChannelVectors) +
+  return power_.capacity() * sizeof(ChannelVectors) + flux_.capacity() * sizeof(Rgb) +
          lighting_.nodes.capacity() * sizeof(ClusterLight) +
          lighting_.flux_prefix.capacity() * sizeof(double) + received_.capacity() * sizeof(Received);
 }

@@ -41,6 +41,19 @@
 // the luminance flux of the emitter cluster. Small clusters that see each
 // other from close by (the faces of a subdivided head across its eyes) carry
 // little light, and link as clusters; a lamp over a table does not.
+//
+// An emitter cluster whose sides do not all face the receiver (the dents of
+// a sculpted mesh, a curved object seen from beside) has no power vector that
+// holds: a side facing away would send negative light. Where the whole light
+// of the pair is below the threshold it links as an isotropic cluster
+// (Sillion 1995): its area-average radiance from the area it shows towards
+// the receiver, A_Y(w) L_Y / A_Y in place of P . w. A receiving cluster whose
+// sides do not all face the emitter takes such faint light as light from one
+// direction in a spherical-harmonic irradiance of order 2 (Ramamoorthi and
+// Hanrahan 2001): nine numbers per channel, summed over its links and down
+// the tree, from which each side reads the light on its own normal (the
+// clamped cosine of one direction to within a tenth of its peak: a side
+// facing away gets 6 % of what one facing it gets).
 #pragma once
 
 #include <array>
@@ -61,6 +74,14 @@ struct ClusterLink {
   std::int32_t emitter = kNone;
   float visibility = 0.0f;  // fraction of the shadow rays between the clusters that pass
   float extent = 1.0f;      // second-order correction for the clusters' extent (above)
+  // From an isotropic emitter (its sides do not all face the receiver): the
+  // share of its area it shows towards the receiver, A_Y(w) / A_Y.
+  float shown = 0.0f;
+  // To a spherical receiver (its sides do not all face the emitter): the
+  // share of its area it shows towards the emitter, A_X(-w) / A_X.
+  float seen = 0.0f;
+  std::uint8_t isotropic = 0;
+  std::uint8_t spherical = 0;
   // What the point approximation's transfer is multiplied by.
   double transfer() const { return static_cast<double>(visibility) * static_cast<double>(extent); }
 };
@@ -133,9 +154,10 @@ InitialLinks split_cluster_links(const ClusterTree& tree, const Hierarchy& hiera
                                  const std::function<bool()>& cancelled);
 
 // Marks every top-level element that a cluster link ends on (through a
-// receiving cluster) with `mark[element] = 1`.
-void mark_cluster_receivers(const ClusterTree& tree, std::span<const ClusterLink> links,
-                            std::vector<std::uint8_t>& mark);
+// receiving cluster) and that faces some of what sends to it with
+// `mark[element] = 1`: the sides that gather far light.
+void mark_cluster_receivers(const ClusterTree& tree, const Hierarchy& hierarchy,
+                            std::span<const ClusterLink> links, std::vector<std::uint8_t>& mark);
 
 // What every top-level element gathers through the cluster links, at its
 // samples (far light, first-order accurate over each receiving cluster), and
@@ -159,8 +181,10 @@ class ClusterGather {
   struct Received {
     ChannelVectors at_centre{};         // S
     std::array<glm::mat3, 3> change{};  // G
+    std::array<std::array<float, 9>, 3> harmonics{};  // of spherical links' light
   };
   std::vector<ChannelVectors> power_;  // per cluster node
+  std::vector<Rgb> flux_;              // per cluster node: sum of L A
   ClusterLighting lighting_;
   std::vector<Received> received_;     // per cluster node
 };

@@ -65,25 +65,36 @@ std::vector<double> delivered_fractions(const Hierarchy& h, const std::vector<Li
     // the emitter cluster V (n_q . w) A_q (-N_X . w) / (pi d^2) per unit
     // radiance, N_X = sum of A n over X (every side of X faces the emitter):
     // per unit area of q that is n_q . v, v summed down the emitter's tree.
+    // From an isotropic emitter every side delivers alike per unit area,
+    // V shown (-N_X . w) / (pi d^2): u, summed down likewise.
     const auto& nodes = tree.nodes();
     std::vector<dvec3> v(nodes.size(), dvec3(0.0));
+    std::vector<double> u(nodes.size(), 0.0);
     for (const ClusterLink& link : far) {
       const ClusterNode& x = tree.node(link.receiver);
       const dvec3 between = x.centre - tree.node(link.emitter).centre;
       const double d2 = glm::dot(between, between);
       const dvec3 w = between / std::sqrt(d2);
-      const double received = std::max(0.0, -glm::dot(x.area_normal, w));
-      v[static_cast<size_t>(link.emitter)] +=
-          link.transfer() / (std::numbers::pi * d2) * received * w;
+      const double received = link.spherical ? static_cast<double>(link.seen) * x.area
+                                             : std::max(0.0, -glm::dot(x.area_normal, w));
+      const double coupling = link.transfer() / (std::numbers::pi * d2) * received;
+      if (link.isotropic)
+        u[static_cast<size_t>(link.emitter)] += coupling * static_cast<double>(link.shown);
+      else
+        v[static_cast<size_t>(link.emitter)] += coupling * w;
     }
     for (size_t i = 0; i < nodes.size(); ++i) {
       const ClusterNode& node = nodes[i];
       if (!node.is_leaf()) {
-        for (std::int32_t c : node.child) v[static_cast<size_t>(c)] += v[i];
+        for (std::int32_t c : node.child) {
+          v[static_cast<size_t>(c)] += v[i];
+          u[static_cast<size_t>(c)] += u[i];
+        }
         continue;
       }
       const std::int32_t side = tree.sides()[node.first];
-      delivered[static_cast<size_t>(side)] += std::max(0.0, glm::dot(h.normal(h.element(side)), v[i]));
+      delivered[static_cast<size_t>(side)] +=
+          std::max(0.0, glm::dot(h.normal(h.element(side)), v[i])) + u[i];
     }
   }
   // Parents come before their children.

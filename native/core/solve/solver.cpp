@@ -332,7 +332,7 @@ void Solver::drop_links_light_cannot_reach() {
       reached[static_cast<size_t>(root)] = 1;
   }
   for (const LightLink& l : light_links_) reached[static_cast<size_t>(l.receiver)] = 1;
-  mark_cluster_receivers(clusters_, cluster_links_, reached);
+  mark_cluster_receivers(clusters_, hierarchy_, cluster_links_, reached);
   for (bool spread = true; spread;) {
     spread = false;
     for (const Link& l : links_) {
@@ -348,7 +348,7 @@ void Solver::drop_links_light_cannot_reach() {
 // Every top-level element under a receiving cluster has links.
 void Solver::mark_cluster_receivers_linked() {
   std::vector<std::uint8_t> marked(hierarchy_.root_count(), 0);
-  mark_cluster_receivers(clusters_, cluster_links_, marked);
+  mark_cluster_receivers(clusters_, hierarchy_, cluster_links_, marked);
   for (size_t e = 0; e < marked.size(); ++e)
     if (marked[e]) hierarchy_.element(static_cast<std::int32_t>(e)).has_links = 1;
 }
