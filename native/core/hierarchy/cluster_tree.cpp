@@ -124,7 +124,6 @@ std::int32_t ClusterTree::build(const Hierarchy& hierarchy, std::uint32_t first,
       const Element& x = hierarchy.element(e);
       return facing_class(hierarchy.normal(x)) + (luminance(hierarchy.emission(x)) > 0.0 ? 6 : 0);
     };
-    const auto centre_of = [&](std::int32_t e) { return hierarchy.centre(hierarchy.element(e)); };
     std::stable_sort(begin, end,
                      [&](std::int32_t a, std::int32_t b) { return class_of(a) < class_of(b); });
     std::uint32_t half = 0;

@@ -163,41 +163,95 @@ struct Cut {
   double narrowest;
 };
 
+// The pieces a patch is cut into, each with its bounding box, so that a cut
+// only looks at the pieces its segment can pass through.
+class Pieces {
+ public:
+  explicit Pieces(const Polygon2& whole) { add(whole); }
+  const std::vector<Polygon2>& polygons() const { return polygons_; }
+  std::vector<Polygon2> take() { return std::move(polygons_); }
+
+  // Calls visit(index) for every piece whose box meets the segment's.
+  template <typename Visit>
+  void near(const Segment& s, const Visit& visit) const {
+    const dvec2 lo = glm::min(s.a, s.b), hi = glm::max(s.a, s.b);
+    for (size_t i = 0; i < polygons_.size(); ++i)
+      if (lo_[i].x <= hi.x && hi_[i].x >= lo.x && lo_[i].y <= hi.y && hi_[i].y >= lo.y) visit(i);
+  }
+  // Splits every piece the cut passes through along it.
+  void cut(const Cut& cut, double thinnest) {
+    std::vector<size_t> crossed;
+    near(cut.segment, [&](size_t i) {
+      if (length_inside(polygons_[i], cut.segment) > thinnest) crossed.push_back(i);
+    });
+    Polygon2 left, right;
+    for (size_t i : crossed) {
+      if (!split(polygons_[i], cut.segment, cut.narrowest, left, right)) continue;
+      replace(i, left);
+      add(right);
+    }
+  }
+  // How far the cut runs past its own ends through the pieces it crosses.
+  double past_ends(const Cut& cut, double thinnest) const {
+    double past = 0.0;
+    near(cut.segment, [&](size_t i) {
+      const double inside = length_inside(polygons_[i], cut.segment);
+      if (inside > thinnest) past += length_inside(polygons_[i], cut.segment, -1e9, 1e9) - inside;
+    });
+    return past;
+  }
+
+ private:
+  void add(const Polygon2& polygon) {
+    polygons_.push_back(polygon);
+    lo_.emplace_back(std::numeric_limits<double>::infinity());
+    hi_.emplace_back(-std::numeric_limits<double>::infinity());
+    bound(polygons_.size() - 1);
+  }
+  void replace(size_t i, const Polygon2& polygon) {
+    polygons_[i] = polygon;
+    lo_[i] = dvec2(std::numeric_limits<double>::infinity());
+    hi_[i] = -lo_[i];
+    bound(i);
+  }
+  void bound(size_t i) {
+    for (const Vertex& v : polygons_[i]) {
+      lo_[i] = glm::min(lo_[i], v.p);
+      hi_[i] = glm::max(hi_[i], v.p);
+    }
+  }
+  std::vector<Polygon2> polygons_;
+  std::vector<dvec2> lo_, hi_;
+};
+
 // Cuts the convex piece along every segment. A cut runs across the whole
 // piece it passes through, so that pieces stay convex; the order then decides
 // how far cuts run past their ends: the cut that runs least past its ends goes
 // first (greedy), so that a box's outline on a floor crosses the floor twice,
 // not four times, and the outline of a cabinet against a wall not at all.
+// Choosing among all cuts each time costs the cube of their number (a floor
+// under a furnished house has thousands), so the choice is made within runs
+// of kGreedyRun cuts in their order, which keeps the cuts of one covering face
+// together.
+constexpr size_t kGreedyRun = 24;
+
 std::vector<Polygon2> cut_along(const Polygon2& whole, std::vector<Cut> cuts, double thinnest) {
-  std::vector<Polygon2> pieces{whole};
-  Polygon2 left, right;
-  while (!cuts.empty()) {
-    size_t best = 0;
-    double least = std::numeric_limits<double>::infinity();
-    for (size_t k = 0; k < cuts.size(); ++k) {
-      double past_ends = 0.0;
-      for (const Polygon2& piece : pieces) {
-        const double inside = length_inside(piece, cuts[k].segment);
-        if (inside > thinnest)
-          past_ends += length_inside(piece, cuts[k].segment, -1e9, 1e9) - inside;
+  Pieces pieces(whole);
+  for (size_t begin = 0; begin < cuts.size(); begin += kGreedyRun) {
+    std::vector<Cut> run(cuts.begin() + static_cast<std::ptrdiff_t>(begin),
+                         cuts.begin() + static_cast<std::ptrdiff_t>(std::min(cuts.size(), begin + kGreedyRun)));
+    while (!run.empty()) {
+      size_t best = 0;
+      double least = std::numeric_limits<double>::infinity();
+      for (size_t k = 0; k < run.size(); ++k) {
+        const double past = pieces.past_ends(run[k], thinnest);
+        if (past < least) least = past, best = k;
       }
-      if (past_ends < least) least = past_ends, best = k;
+      pieces.cut(run[best], thinnest);
+      run.erase(run.begin() + static_cast<std::ptrdiff_t>(best));
     }
-    const Cut cut = cuts[best];
-    cuts.erase(cuts.begin() + static_cast<std::ptrdiff_t>(best));
-    std::vector<Polygon2> next;
-    for (const Polygon2& piece : pieces) {
-      if (length_inside(piece, cut.segment) > thinnest &&
-          split(piece, cut.segment, cut.narrowest, left, right)) {
-        next.push_back(left);
-        next.push_back(right);
-      } else {
-        next.push_back(piece);
-      }
-    }
-    pieces = std::move(next);
   }
-  return pieces;
+  return pieces.take();
 }
 
 // What of patch Q touches patch P: cut segments in P's frame, and, where Q

@@ -199,8 +199,9 @@ enum class RayVerdict : std::uint8_t { Link, Hidden, Split };
 RayVerdict ray_verdict(const Judgement& j, const ClusterCriterion& c, float visibility,
                        bool single_receiver) {
   if (visibility >= 1.0f) return RayVerdict::Link;
-  if (visibility <= 0.0f) return j.by_distance ? RayVerdict::Hidden : RayVerdict::Split;
-  return faint(kShadowWeight * j.light, c) || (j.by_distance && single_receiver)
+  const bool shadow_faint = faint(kShadowWeight * j.light, c);
+  if (visibility <= 0.0f) return j.by_distance || shadow_faint ? RayVerdict::Hidden : RayVerdict::Split;
+  return shadow_faint || (j.by_distance && single_receiver)
              ? RayVerdict::Link
              : RayVerdict::Split;
 }
@@ -605,8 +606,9 @@ void ClusterGather::operator()(const ClusterTree& tree, const std::vector<Cluste
           const dvec3 u = -r / std::sqrt(d2);
           const std::array<double, 9> y = harmonics(u);
           for (size_t c = 0; c < 3; ++c) {
-            const double i = k4 * glm::dot(p[c], r) * std::sqrt(d2);
-            for (size_t m = 0; m < 9; ++m) to.harmonics[c][m] += static_cast<float>(i * y[m]);
+            const double intensity = k4 * glm::dot(p[c], r) * std::sqrt(d2);
+            for (size_t m = 0; m < 9; ++m)
+              to.harmonics[c][m] += static_cast<float>(intensity * y[m]);
           }
           continue;
         }
@@ -654,10 +656,11 @@ void ClusterGather::operator()(const ClusterTree& tree, const std::vector<Cluste
       const std::array<double, 9> y = harmonics(n);
       Rgb spherical(0.0);
       for (int c = 0; c < 3; ++c) {
-        double e = 0.0;
+        double irradiance = 0.0;
         for (size_t m = 0; m < 9; ++m)
-          e += kClampedCosine[m] * static_cast<double>(field.harmonics[static_cast<size_t>(c)][m]) * y[m];
-        spherical[c] = std::max(0.0, e);
+          irradiance += kClampedCosine[m] *
+                        static_cast<double>(field.harmonics[static_cast<size_t>(c)][m]) * y[m];
+        spherical[c] = std::max(0.0, irradiance);
       }
       for (int s = 0; s < count; ++s) {
         const glm::vec3 offset(at[s] - node.centre);
