@@ -588,7 +588,9 @@ class Cancellation(unittest.TestCase):
         worker.join()
         self.assertEqual(os.getpriority(os.PRIO_PROCESS, threading.get_native_id()), before,
                          "the caller's other threads keep their priority")
-        self.assertGreater(seen["nice"], before)
+        # The solve's threads go to niceness 5 (kSolveNiceness) unless the
+        # caller already runs nicer (a test run under `nice`), never back up.
+        self.assertEqual(seen["nice"], max(before, 5))
         np.testing.assert_array_equal(seen["result"].radiance, plain.radiance)
 
     def test_linking_a_large_scene_reports_progress(self):

@@ -88,7 +88,8 @@ std::int32_t ClusterTree::build(const Hierarchy& hierarchy, std::uint32_t first,
       corners[k] -= node.centre;
       node.radius = std::max(node.radius, glm::length(corners[k]));
     }
-    for (int k = 1; k + 1 < n; ++k) moment += triangle_moment(corners[0], corners[k], corners[k + 1]);
+    for (int k = 1; k + 1 < n; ++k)
+      moment += triangle_moment(corners[0], corners[k], corners[k + 1]);
   }
   if (node.area > 0.0) {
     const glm::dmat3 c = moment / node.area;

@@ -19,7 +19,7 @@ struct ClusterNode {
   double radius = 0.0;     // of the sphere about `centre` holding every side
   dvec3 axis{0.0};         // of the normals' cone (area-weighted mean normal)
   dvec3 area_normal{0.0};  // sum of its sides' area times normal
-  double spread = 0.0;  // the cone's half-angle, radians
+  double spread = 0.0;     // the cone's half-angle, radians
   // Heights of its sides' corners along `axis`: where every side faces along
   // the axis (is_flat: a floor, a tiled wall), a side sees only what rises
   // above its own plane (cluster_links.cpp prunes coplanar pairs with this).

@@ -238,8 +238,9 @@ constexpr size_t kGreedyRun = 24;
 std::vector<Polygon2> cut_along(const Polygon2& whole, std::vector<Cut> cuts, double thinnest) {
   Pieces pieces(whole);
   for (size_t begin = 0; begin < cuts.size(); begin += kGreedyRun) {
-    std::vector<Cut> run(cuts.begin() + static_cast<std::ptrdiff_t>(begin),
-                         cuts.begin() + static_cast<std::ptrdiff_t>(std::min(cuts.size(), begin + kGreedyRun)));
+    std::vector<Cut> run(
+        cuts.begin() + static_cast<std::ptrdiff_t>(begin),
+        cuts.begin() + static_cast<std::ptrdiff_t>(std::min(cuts.size(), begin + kGreedyRun)));
     while (!run.empty()) {
       size_t best = 0;
       double least = std::numeric_limits<double>::infinity();

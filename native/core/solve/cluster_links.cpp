@@ -5,8 +5,8 @@
 
 #include <atomic>
 #include <cmath>
-#include <numbers>
 #include <limits>
+#include <numbers>
 #include <span>
 
 #include "core/geometry/random.h"
@@ -132,7 +132,8 @@ int passing_rays(const ClusterTree& tree, std::span<const SideSample> sides, con
     const double share_from = (rays - 1 - k + random.uniform()) / rays;
     const double share_to = (k + random.uniform()) / rays;
     const dvec3 from = point_at(from_prefix, sides, from_node, share_from, random, from_face);
-    const dvec3 to = point_at(tree.area_prefix(), sides, tree.node(receiver), share_to, random, to_face);
+    const dvec3 to =
+        point_at(tree.area_prefix(), sides, tree.node(receiver), share_to, random, to_face);
     passed += scene.occluded(from, to, from_face, to_face) ? 0 : 1;
   }
   return passed;
@@ -171,8 +172,8 @@ Judgement judge(const ClusterNode& rx, const ClusterNode& ry, std::int32_t y, do
       gap > 0.0 ? std::min(static_cast<double>(light.peak),
                            static_cast<double>(light.flux) / (std::numbers::pi * gap * gap))
                 : static_cast<double>(light.peak);
-  j.light = static_cast<double>(rx.reflectance) * rx.area * irradiance /
-            (c.adaptation * c.total_area);
+  j.light =
+      static_cast<double>(rx.reflectance) * rx.area * irradiance / (c.adaptation * c.total_area);
   return j;
 }
 
@@ -191,19 +192,18 @@ bool may_link(const Judgement& j, const ClusterCriterion& c) {
 // place is what shows first: the insides of a field of boxes lit through
 // their walls), is below the threshold, or (far enough apart) one ending on a
 // single side, which then sees the emitter cluster's average; otherwise the
-// pair is split, down to pairs of sides, whose links see exactly. None passing says the pair is hidden, which is taken where a
-// mistake would cost little (a reflecting cluster far apart) and otherwise
-// checked the same way: a lamp must not go dark by sixteen unlucky rays.
+// pair is split, down to pairs of sides, whose links see exactly. None passing says the pair is
+// hidden, which is taken where a mistake would cost little (a reflecting cluster far apart) and
+// otherwise checked the same way: a lamp must not go dark by sixteen unlucky rays.
 constexpr double kShadowWeight = 10.0;
 enum class RayVerdict : std::uint8_t { Link, Hidden, Split };
 RayVerdict ray_verdict(const Judgement& j, const ClusterCriterion& c, float visibility,
                        bool single_receiver) {
   if (visibility >= 1.0f) return RayVerdict::Link;
   const bool shadow_faint = faint(kShadowWeight * j.light, c);
-  if (visibility <= 0.0f) return j.by_distance || shadow_faint ? RayVerdict::Hidden : RayVerdict::Split;
-  return shadow_faint || (j.by_distance && single_receiver)
-             ? RayVerdict::Link
-             : RayVerdict::Split;
+  if (visibility <= 0.0f)
+    return j.by_distance || shadow_faint ? RayVerdict::Hidden : RayVerdict::Split;
+  return shadow_faint || (j.by_distance && single_receiver) ? RayVerdict::Link : RayVerdict::Split;
 }
 
 struct Walk {
@@ -421,7 +421,8 @@ std::vector<Box> senders(const ClusterTree& tree, std::span<const ClusterLink> l
   std::vector<Box> box(nodes.size());
   for (const ClusterLink& l : links) {
     const ClusterNode& y = tree.node(l.emitter);
-    box[static_cast<size_t>(l.receiver)].add({y.centre - dvec3(y.radius), y.centre + dvec3(y.radius)});
+    box[static_cast<size_t>(l.receiver)].add(
+        {y.centre - dvec3(y.radius), y.centre + dvec3(y.radius)});
   }
   for (size_t i = 0; i < nodes.size(); ++i)  // parents before children
     if (!nodes[i].is_leaf())
@@ -496,7 +497,7 @@ ClusterLighting lighting_of(const ClusterTree& tree, const Hierarchy& hierarchy,
 }  // namespace
 
 ClusterLighting estimated_cluster_light(const ClusterTree& tree, const Hierarchy& hierarchy,
-                                       double radiance) {
+                                        double radiance) {
   return lighting_of(tree, hierarchy, [&](std::int32_t side) {
     const Element& e = hierarchy.element(side);
     const double emitted = luminance(hierarchy.emission(e));
@@ -677,7 +678,8 @@ void ClusterGather::operator()(const ClusterTree& tree, const std::vector<Cluste
 std::size_t ClusterGather::memory_bytes() const {
   return power_.capacity() * sizeof(ChannelVectors) + flux_.capacity() * sizeof(Rgb) +
          lighting_.nodes.capacity() * sizeof(ClusterLight) +
-         lighting_.flux_prefix.capacity() * sizeof(double) + received_.capacity() * sizeof(Received);
+         lighting_.flux_prefix.capacity() * sizeof(double) +
+         received_.capacity() * sizeof(Received);
 }
 
 }  // namespace radiosity

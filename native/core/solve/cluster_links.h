@@ -125,7 +125,7 @@ struct ClusterCriterion {
 // reference radiance), so the first pass links by a guess that later passes
 // correct (refinement reads the solved radiances).
 ClusterLighting estimated_cluster_light(const ClusterTree& tree, const Hierarchy& hierarchy,
-                                       double radiance);
+                                        double radiance);
 
 struct InitialLinks {
   std::vector<ClusterLink> clusters;
@@ -179,14 +179,14 @@ class ClusterGather {
  private:
   using ChannelVectors = std::array<dvec3, 3>;  // one vector per colour channel
   struct Received {
-    ChannelVectors at_centre{};         // S
-    std::array<glm::mat3, 3> change{};  // G
+    ChannelVectors at_centre{};                       // S
+    std::array<glm::mat3, 3> change{};                // G
     std::array<std::array<float, 9>, 3> harmonics{};  // of spherical links' light
   };
   std::vector<ChannelVectors> power_;  // per cluster node
   std::vector<Rgb> flux_;              // per cluster node: sum of L A
   ClusterLighting lighting_;
-  std::vector<Received> received_;     // per cluster node
+  std::vector<Received> received_;  // per cluster node
 };
 
 // Orders cluster links by receiver, then emitter (what ClusterGather reads).

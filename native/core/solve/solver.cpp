@@ -244,8 +244,9 @@ double Solver::pass_fraction(double within) const { return 0.1 + 0.9 * (pass_ + 
 void Solver::track_memory() {
   stats_.element_bytes = hierarchy_.memory_bytes() + offset_.capacity() * sizeof(std::uint32_t) +
                          source_.capacity() * sizeof(Rgb) + clusters_.memory_bytes() +
-                         cluster_gather_.memory_bytes() + far_light_.capacity() * sizeof(SampleRgb) +
-                         balance_.memory_bytes() + direct_light_.capacity() * sizeof(SampleRgb);
+                         cluster_gather_.memory_bytes() +
+                         far_light_.capacity() * sizeof(SampleRgb) + balance_.memory_bytes() +
+                         direct_light_.capacity() * sizeof(SampleRgb);
   stats_.link_bytes = links_.capacity() * sizeof(Link) + order_.capacity() * sizeof(std::uint32_t) +
                       cluster_links_.capacity() * sizeof(ClusterLink) +
                       light_links_.capacity() * sizeof(LightLink);
