@@ -168,7 +168,6 @@ struct Cut {
 class Pieces {
  public:
   explicit Pieces(const Polygon2& whole) { add(whole); }
-  const std::vector<Polygon2>& polygons() const { return polygons_; }
   std::vector<Polygon2> take() { return std::move(polygons_); }
 
   // Calls visit(index) for every piece whose box meets the segment's.
@@ -203,18 +202,15 @@ class Pieces {
 
  private:
   void add(const Polygon2& polygon) {
-    polygons_.push_back(polygon);
-    lo_.emplace_back(std::numeric_limits<double>::infinity());
-    hi_.emplace_back(-std::numeric_limits<double>::infinity());
-    bound(polygons_.size() - 1);
+    polygons_.emplace_back();
+    lo_.emplace_back();
+    hi_.emplace_back();
+    replace(polygons_.size() - 1, polygon);
   }
   void replace(size_t i, const Polygon2& polygon) {
     polygons_[i] = polygon;
     lo_[i] = dvec2(std::numeric_limits<double>::infinity());
     hi_[i] = -lo_[i];
-    bound(i);
-  }
-  void bound(size_t i) {
     for (const Vertex& v : polygons_[i]) {
       lo_[i] = glm::min(lo_[i], v.p);
       hi_[i] = glm::max(hi_[i], v.p);
