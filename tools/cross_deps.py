@@ -1,0 +1,148 @@
+#!/usr/bin/env python3
+"""What the Windows and macOS modules' builds need, made once per platform under
+BUILD/cross/PLATFORM; a no-op once there (`make package` and `make test-platforms`
+run it through tools/cross_build.py).
+
+The Linux build's recipe (tools/portable_deps.py) for other targets of the same zig:
+- wrappers and a CMake toolchain file for zig's clang targeting the platform
+  (Windows: x86_64-windows-gnu, MinGW-w64 headers over the Universal CRT with
+  LLVM's libc++ linked in; macOS: aarch64-macos.11.0 or x86_64-macos.11.0, the
+  Mach-O linker against zig's libSystem stubs, libc++ linked in);
+- Embree and oneTBB from the same pinned Debian sources, built static for it.
+  Embree as on Linux (triangles, filter functions, single rays, its own tasking),
+  with one ISA: SSE2 on x86-64, NEON (Embree's ARM path, sse2neon) on arm64.
+
+    python3 tools/cross_deps.py --build build windows-x64 [macos-arm64 macos-x64]
+"""
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import portable_deps  # tools/portable_deps.py: zig, the Debian sources, the static builds
+
+# platform (Blender's name) -> zig's target and CMake's system name and processor
+PLATFORMS = {
+    "windows-x64": {"zig": "x86_64-windows-gnu", "system": "Windows", "processor": "AMD64"},
+    "macos-arm64": {"zig": "aarch64-macos.11.0", "system": "Darwin", "processor": "arm64"},
+    "macos-x64": {"zig": "x86_64-macos.11.0", "system": "Darwin", "processor": "x86_64"},
+}
+# The Linux build's Embree options, but one ISA a target has: NEON on arm64 (its
+# double-pumped NEON2X, Embree's default on Apple, doubles the kernels built).
+ARM_ISA = ["-DEMBREE_ISA_NEON=ON", "-DEMBREE_ISA_NEON2X=OFF"]
+# MinGW's math.h declares M_PI, which Embree uses, only when asked to.
+WINDOWS_EMBREE = ["-DEMBREE_IGNORE_CMAKE_CXX_FLAGS=OFF", "-DCMAKE_CXX_FLAGS=-D_USE_MATH_DEFINES"]
+# Windows: oneTBB's version resource (tbb.rc) is compiled by zig's resource
+# compiler; nothing links it, as nothing references it in the static library.
+RC_WRAPPER = """#!/usr/bin/env python3
+# windres's command line (as CMake gives it for MinGW) to `zig rc` (tools/cross_deps.py).
+import os, sys
+args, out, defines = sys.argv[1:], None, []
+source = None
+i = 0
+while i < len(args):
+    a = args[i]
+    if a in ("-O", "--output-format"):
+        i += 1
+    elif a.startswith("-D") or a.startswith("-I"):
+        defines.append(("/d" if a[1] == "D" else "/i") + (a[2:] or args[i + 1]))
+        i += 0 if a[2:] else 1
+    elif a in ("-o",):
+        out = args[i + 1]; i += 1
+    elif a.startswith("-"):
+        pass
+    elif source is None:
+        source = a
+    else:
+        out = a
+    i += 1
+os.environ["ZIG_GLOBAL_CACHE_DIR"] = %(cache)r
+os.execv(%(python)r, [%(python)r, "-m", "ziglang", "rc", "/:output-format", "coff", "/:target", "x64",
+                      *defines, "/fo", out, source])
+"""
+
+
+def log(message):
+    print("[cross] " + message, flush=True)
+
+
+def folder_of(build, platform):
+    return Path(build).resolve() / "cross" / platform
+
+
+def cache_of(build):
+    """One zig cache for every cross target (its libc++ and C runtimes, per target)."""
+    return Path(build).resolve() / "cross" / "zig-cache"
+
+
+def toolchain(build, platform):
+    """Wrappers and zig.cmake for `platform` in its folder."""
+    spec, folder = PLATFORMS[platform], folder_of(build, platform)
+    python = portable_deps_folder(build) / "zig-env" / "bin" / "python"
+    cache = cache_of(build)
+    bin_dir = folder / "bin"
+    bin_dir.mkdir(parents=True, exist_ok=True)
+    for name, command in (("zcc", "cc -target " + spec["zig"]), ("zc++", "c++ -target " + spec["zig"]),
+                          ("zar", "ar"), ("zranlib", "ranlib")):
+        path = bin_dir / name
+        path.write_text('#!/bin/sh\nZIG_GLOBAL_CACHE_DIR="%s" exec "%s" -m ziglang %s "$@"\n'
+                        % (cache, python, command))
+        path.chmod(0o755)
+    lines = ["# zig targeting %s (tools/cross_deps.py)" % spec["zig"],
+             "set(CMAKE_SYSTEM_NAME %s)" % spec["system"], "set(CMAKE_SYSTEM_PROCESSOR %s)" % spec["processor"],
+             "set(CMAKE_C_COMPILER %s/zcc)" % bin_dir, "set(CMAKE_CXX_COMPILER %s/zc++)" % bin_dir,
+             "set(CMAKE_AR %s/zar)" % bin_dir, "set(CMAKE_RANLIB %s/zranlib)" % bin_dir]
+    if spec["system"] == "Windows":
+        rc = bin_dir / "zwindres"
+        rc.write_text(RC_WRAPPER % {"cache": str(cache), "python": str(python)})
+        rc.chmod(0o755)
+        lines.append("set(CMAKE_RC_COMPILER %s)" % rc)
+    else:
+        # No SDK here: zig brings the headers and libSystem's stubs; the target's
+        # version (11.0) is the minimum macOS.
+        lines += ["set(CMAKE_OSX_SYSROOT \"\")", "set(CMAKE_OSX_DEPLOYMENT_TARGET \"\")",
+                  "set(CMAKE_OSX_ARCHITECTURES \"\")"]
+    (folder / "zig.cmake").write_text("\n".join(lines) + "\n")
+
+
+def portable_deps_folder(build):
+    return Path(build).resolve() / "portable-deps"
+
+
+def embree_options(platform):
+    options = list(portable_deps.EMBREE_OPTIONS)
+    if PLATFORMS[platform]["processor"] == "arm64":
+        options = [o for o in options if not o.startswith("-DEMBREE_ISA_")] + ARM_ISA
+    if PLATFORMS[platform]["system"] == "Windows":
+        options += WINDOWS_EMBREE
+    return options
+
+
+def build(build_dir, platform):
+    """Embree and oneTBB static for `platform`; returns its folder (the CMake prefix)."""
+    shared = portable_deps_folder(build_dir)
+    shared.mkdir(parents=True, exist_ok=True)
+    portable_deps.zig(shared)             # the one zig, shared with the Linux build
+    src = portable_deps.sources(shared)   # the one copy of the Debian sources
+    folder = folder_of(build_dir, platform)
+    toolchain(build_dir, platform)
+    start = time.perf_counter()
+    portable_deps.build_static(folder, "onetbb", src["onetbb"], portable_deps.TBB_OPTIONS)
+    portable_deps.build_static(folder, "embree", src["embree"], embree_options(platform))
+    log("%s: Embree and oneTBB ready in %s (%.0f s)" % (platform, folder, time.perf_counter() - start))
+    return folder
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--build", default="build", help="build directory")
+    parser.add_argument("platforms", nargs="+", choices=PLATFORMS)
+    args = parser.parse_args()
+    for platform in args.platforms:
+        build(args.build, platform)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
