@@ -19,6 +19,13 @@ if [[ "${1:-}" == fuzz ]]; then
   packages+=(clang-16 libclang-rt-16-dev)
 fi
 
+# `make test-platforms` (tools/cross_build.py, tests/platforms) runs the Windows modules
+# under Wine (Debian's Wine 8: wine, wine64) and reads the macOS modules' Mach-O with
+# LLVM's tools (llvm-objdump-16, llvm-nm-16): only asked for by `install-deps.sh platforms`.
+if [[ "${1:-}" == platforms ]]; then
+  packages+=(wine wine64 llvm-16)
+fi
+
 # Node.js and npm run the Khronos glTF validator (tools/gltf_validator.py, which
 # installs the validator itself into the build tree). Checked by command: a
 # Node.js from elsewhere (NodeSource's nodejs, which includes npm) will do.

@@ -33,7 +33,7 @@ PLATFORMS = {
 ARM_ISA = ["-DEMBREE_ISA_NEON=ON", "-DEMBREE_ISA_NEON2X=OFF"]
 # MinGW's math.h declares M_PI, which Embree uses, only when asked to.
 WINDOWS_EMBREE = ["-DEMBREE_IGNORE_CMAKE_CXX_FLAGS=OFF", "-DCMAKE_CXX_FLAGS=-D_USE_MATH_DEFINES"]
-# Windows: oneTBB's version resource (tbb.rc) is compiled by zig's resource
+# Windows: oneTBB's and Embree's version resources (tbb.rc, embree.rc) are compiled by zig's resource
 # compiler; nothing links it, as nothing references it in the static library.
 RC_WRAPPER = """#!/usr/bin/env python3
 # windres's command line (as CMake gives it for MinGW) to `zig rc` (tools/cross_deps.py).
@@ -57,6 +57,11 @@ while i < len(args):
     else:
         out = a
     i += 1
+if open(source, "rb").read(2) == b"\\xff\\xfe":   # UTF-16 (embree.rc), which zig rc rejects: as UTF-8
+    text = open(source, encoding="utf-16").read()
+    defines.append("/i" + os.path.dirname(os.path.abspath(source)))
+    source = out + ".utf8.rc"
+    open(source, "w", encoding="utf-8").write(text)
 os.environ["ZIG_GLOBAL_CACHE_DIR"] = %(cache)r
 os.execv(%(python)r, [%(python)r, "-m", "ziglang", "rc", "/:output-format", "coff", "/:target", "x64",
                       *defines, "/fo", out, source])

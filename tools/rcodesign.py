@@ -1,0 +1,93 @@
+#!/usr/bin/env python3
+"""rcodesign, the pure-Rust signer of Apple code (crates.io's apple-codesign, pinned),
+built once with cargo into BUILD/cross/rcodesign; signs the macOS modules ad hoc
+and verifies their signatures (tools/cross_build.py, tests/platforms).
+
+Without its default feature (notarisation, which pulls in an AWS SDK): ad hoc
+signing and verification need none of it. Needs cargo and rustc 1.81 or later
+(rustup's, as on this project's machines; Debian 12's Rust 1.63 is too old).
+
+    python3 tools/rcodesign.py install --build build      # prints its path
+    python3 tools/rcodesign.py sign --build build FILE...
+"""
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+CRATE = "apple-codesign"
+VERSION = "0.29.0"
+
+
+def folder(build):
+    return Path(build).resolve() / "cross" / "rcodesign"
+
+
+def executable(build):
+    return folder(build) / "bin" / "rcodesign"
+
+
+def cargo():
+    found = shutil.which("cargo") or str(Path.home() / ".cargo" / "bin" / "cargo")
+    if not os.access(found, os.X_OK):
+        sys.exit("error: cargo not found: rcodesign (%s %s) is built with it; install Rust 1.81+ (rustup)"
+                 % (CRATE, VERSION))
+    return found
+
+
+def install(build):
+    """rcodesign's path, building it first when missing or of another version."""
+    stamp = folder(build) / "version.txt"
+    if executable(build).exists() and stamp.exists() and stamp.read_text() == VERSION:
+        return executable(build)
+    print("[rcodesign] building %s %s with cargo (minutes, once)" % (CRATE, VERSION), flush=True)
+    start = time.perf_counter()
+    log = folder(build).parent / "rcodesign-build.log"
+    log.parent.mkdir(parents=True, exist_ok=True)
+    with open(log, "w") as out:
+        proc = subprocess.run([cargo(), "install", "%s@%s" % (CRATE, VERSION), "--locked", "--no-default-features",
+                               "--root", str(folder(build)), "--force", "-j", str(os.cpu_count() or 1)],
+                              stdout=out, stderr=subprocess.STDOUT)
+    if proc.returncode != 0:
+        sys.exit("error: cargo install %s failed; see %s:\n%s" % (CRATE, log, log.read_text()[-3000:]))
+    stamp.write_text(VERSION)
+    print("[rcodesign] built in %.0f s" % (time.perf_counter() - start), flush=True)
+    return executable(build)
+
+
+def sign(build, path):
+    """Sign `path` ad hoc in place (replacing the linker's signature, if any)."""
+    subprocess.run([str(install(build)), "sign", str(path)], check=True, capture_output=True, text=True)
+
+
+def verify(build, path):
+    """(ok, output) of `rcodesign verify` on `path`."""
+    proc = subprocess.run([str(install(build)), "verify", str(path)], capture_output=True, text=True)
+    return proc.returncode == 0, proc.stdout + proc.stderr
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("action", choices=("install", "sign", "verify"))
+    parser.add_argument("--build", default="build", help="build directory")
+    parser.add_argument("files", nargs="*")
+    args = parser.parse_args()
+    if args.action == "install":
+        print(install(args.build))
+    for path in args.files:
+        if args.action == "sign":
+            sign(args.build, path)
+        else:
+            ok, output = verify(args.build, path)
+            print(output.strip())
+            if not ok:
+                return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
