@@ -6,7 +6,6 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
-#include <sys/resource.h>
 
 #include <algorithm>
 #include <atomic>
@@ -16,6 +15,7 @@
 #include <optional>
 #include <string>
 
+#include "core/solve/system_memory.h"
 #include "python/bindings.h"
 #include "python/numpy_input.h"
 #include "radiosity/scene.h"
@@ -242,9 +242,7 @@ py::dict stats_dict(const SolveStats& s) {
   const std::size_t all_links = s.links + s.cluster_links;
   d["bytes_per_link"] =
       all_links ? static_cast<double>(s.link_bytes) / static_cast<double>(all_links) : 0.0;
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  d["peak_rss_bytes"] = static_cast<std::size_t>(usage.ru_maxrss) * 1024;
+  d["peak_rss_bytes"] = peak_resident_bytes();
   return d;
 }
 

@@ -2,12 +2,10 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -22,6 +20,7 @@
 #include "core/solve/link_batch.h"
 #include "core/solve/refine.h"
 #include "core/solve/reuse.h"
+#include "core/solve/system_memory.h"
 #include "core/solve/timing.h"
 #include "core/solve/yield_priority.h"
 #include "radiosity/solve.h"
@@ -77,22 +76,6 @@ constexpr double kNoRefinement = std::numeric_limits<double>::infinity();
 
 // Shadow rays that measure a cluster link's visible fraction.
 constexpr int kClusterRays = 16;
-
-// Bytes of memory available now (Linux: MemAvailable), or a large number
-// where it cannot be read.
-std::size_t available_memory() {
-  std::ifstream meminfo("/proc/meminfo");
-  std::string key;
-  std::size_t kilobytes = 0;
-  std::string unit;
-  while (meminfo >> key >> kilobytes >> unit) {
-    if (key == "MemAvailable:") return kilobytes * 1024;
-  }
-  const long pages = sysconf(_SC_AVPHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-  if (pages > 0 && page > 0)
-    return static_cast<std::size_t>(pages) * static_cast<std::size_t>(page);
-  return std::numeric_limits<std::size_t>::max() / 2;
-}
 
 double gigabytes(std::size_t bytes) { return std::round(static_cast<double>(bytes) / 1e8) / 10.0; }
 

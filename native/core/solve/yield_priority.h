@@ -3,7 +3,8 @@
 // with as many busy solver threads as cores, the interface thread would get
 // only a share of a core, and its timers, redraws and Esc arrive late.
 // Each thread that works for the solve's arena is made "nicer" (Linux: nice
-// applies per thread) when it joins; nothing is raised back, since only
+// applies per thread; Windows: one level below normal; macOS: the "utility"
+// quality of service) when it joins; nothing is raised back, since only
 // privileged processes may raise a priority. The solver's thread pool belongs
 // to the module in the shipped build (TBB linked statically and hidden).
 #pragma once
