@@ -17,6 +17,9 @@
 5. Finely tessellated objects (bench/tessellated_room.py, in Blender): exact
    and sampled visibility against a path trace; <build>/bench/tessellated_room.md.
    Quick mode: the UV sphere only.
+6. A solve in a window against a headless one (bench/window_speed.py, in
+   Blender under xvfb-run): what Esc keeps and what each has refined after
+   2, 4 and 6 s; <build>/bench/window_speed.md. Quick mode: one round.
 """
 
 import argparse
@@ -56,6 +59,10 @@ def main():
     print("== finely tessellated objects", flush=True)
     subprocess.run([args.blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
                     str(ROOT / "bench" / "tessellated_room.py"), "--", "--build", args.build]
+                   + (["--quick"] if args.quick else []), check=True)
+    print("== a solve in a window", flush=True)
+    subprocess.run([args.blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
+                    str(ROOT / "bench" / "window_speed.py"), "--", "--build", args.build]
                    + (["--quick"] if args.quick else []), check=True)
 
 

@@ -162,7 +162,8 @@ def check():
     results = [o for o in bpy.context.scene.objects if o.get("radiosity_result")]
     shading = [s.shading.color_type for a in window().screen.areas for s in a.spaces if s.type == 'VIEW_3D']
     print("RESULT " + json.dumps({
-        "invoke": state["invoke"], "valid": stats.valid, "status": stats.status,
+        "invoke": state["invoke"], "quality": bpy.context.scene.radiosity.quality,
+        "valid": stats.valid, "status": stats.status,
         "elements": stats.elements, "results": len(results), "shading": shading,
         "hidden": all(o.hide_render for o in bpy.context.scene.objects
                       if o.type == 'MESH' and not o.get("radiosity_result")),
