@@ -36,7 +36,7 @@ if "bpy" in locals():
 import bpy
 from bpy.props import PointerProperty
 
-from . import game_export, native, operators, properties, solve_reuse, ui
+from . import game_export, native, operators, properties, solve_reuse, ui, view_sync
 
 # Registration order matters: a PropertyGroup before the group that points to it.
 classes = (
@@ -51,6 +51,7 @@ classes = (
     ui.RENDER_PT_radiosity_quality,
     ui.RENDER_PT_radiosity_output,
     ui.RENDER_PT_radiosity_stats,
+    ui.VIEW3D_PT_radiosity,
     ui.VIEW3D_MT_radiosity,
 )
 
@@ -65,6 +66,7 @@ def register():
     )
     ui.register()  # menu entries, the progress bar's property
     solve_reuse.register()
+    view_sync.register()
     # Try the native module now so the panel can say at once if it is unusable;
     # registration itself never depends on it.
     try:
@@ -74,6 +76,7 @@ def register():
 
 
 def unregister():
+    view_sync.unregister()
     solve_reuse.unregister()
     ui.unregister()
     del bpy.types.Scene.radiosity

@@ -246,7 +246,12 @@ class RADIOSITY_OT_clear(Operator):
 
     @classmethod
     def poll(cls, context):
-        return context.scene is not None
+        if context.scene is None:
+            return False
+        if not result_state.anything_to_remove(context.scene) and not context.scene.radiosity.stats.valid:
+            cls.poll_message_set("No radiosity result to remove")
+            return False
+        return True
 
     def execute(self, context):
         scene = context.scene

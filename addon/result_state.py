@@ -24,8 +24,11 @@ HIDDEN_TAG = "radiosity_hidden"
 ORIGINAL_ATTRIBUTE_TAG = "radiosity_attribute"
 # The shared "Radiosity Emission" material (bake.emission_material).
 MATERIAL_TAG = "radiosity_material"
-# On the scene: how each 3D view was shaded before the result was shown in it
-# (show_in_views), to be put back when the originals come back.
+# On the scene, and on the window manager: how each 3D view was shaded before
+# the result was shown in it (show_in_views), to be put back when the originals
+# come back. The scene's copy is saved with the file; the window manager's
+# outlives an undo that takes the scene back to before the result (views are
+# not undone, the scene is).
 VIEWS_TAG = "radiosity_views"
 COLLECTION_NAME = "Radiosity"
 
@@ -147,6 +150,45 @@ def _attribute_colour(shading):
     return 'ATTRIBUTE' if 'ATTRIBUTE' in items else 'VERTEX'  # 'VERTEX' before Blender 3.2
 
 
+def _window_manager():
+    managers = bpy.data.window_managers
+    return managers[0] if len(managers) else None
+
+
+def _saved_views(scene):
+    """How the views were shaded before the result: the scene's record, else
+    the window manager's (after an undo past the solve)."""
+    wm = _window_manager()
+    text = scene.get(VIEWS_TAG) or (wm.get(VIEWS_TAG) if wm is not None else None)
+    return json.loads(text or "{}")
+
+
+def _save_views(scene, saved):
+    text = json.dumps(saved)
+    scene[VIEWS_TAG] = text
+    wm = _window_manager()
+    if wm is not None:
+        wm[VIEWS_TAG] = text
+
+
+def views_record(scene):
+    """Both copies of the saved shading, for a rollback (scene_transaction.py)."""
+    wm = _window_manager()
+    return scene.get(VIEWS_TAG), wm.get(VIEWS_TAG) if wm is not None else None
+
+
+def put_views_record(scene, record):
+    """Puts back what views_record returned."""
+    wm = _window_manager()
+    for owner, text in ((scene, record[0]), (wm, record[1])):
+        if owner is None:
+            continue
+        if text is None:
+            owner.pop(VIEWS_TAG, None)
+        else:
+            owner[VIEWS_TAG] = text
+
+
 def show_in_views(scene):
     """With "View Result" on, solid shading in every 3D view shows the result's
     colours as computed: the colour attribute, lit flat (studio lighting would
@@ -157,24 +199,42 @@ def show_in_views(scene):
     before is saved once, for restore_views."""
     if not scene.radiosity.view_result:
         return
-    saved = json.loads(scene.get(VIEWS_TAG, "{}"))
+    saved = _saved_views(scene)
     for key, space in _views():
         shading = space.shading
         saved.setdefault(key, [shading.color_type, shading.light, shading.show_backface_culling])
         shading.color_type = _attribute_colour(shading)
         shading.light = 'FLAT'
         shading.show_backface_culling = True
-    scene[VIEWS_TAG] = json.dumps(saved)
+    _save_views(scene, saved)
 
 
 def restore_views(scene):
     """Shade the 3D views as they were before the result was shown in them."""
-    saved = json.loads(scene.get(VIEWS_TAG, "{}"))
+    saved = _saved_views(scene)
     for key, space in _views():
         if key in saved:
             shading = space.shading
             shading.color_type, shading.light, shading.show_backface_culling = saved[key]
     scene.pop(VIEWS_TAG, None)
+    wm = _window_manager()
+    if wm is not None:
+        wm.pop(VIEWS_TAG, None)
+
+
+def result_shown(scene):
+    """Whether the scene shows a radiosity result (not hidden by Toggle)."""
+    return any(not o.hide_viewport for o in result_objects(scene))
+
+
+def sync_views(scene):
+    """Shade the 3D views for what the scene shows now: the result's colours
+    while a result is shown, the views as they were otherwise. Undo, redo and
+    opening a file change the scene but not the views (view_sync.py)."""
+    if result_shown(scene):
+        show_in_views(scene)
+    elif _saved_views(scene):
+        restore_views(scene)
 
 
 # --- Toggling and removing ---------------------------------------------------------------
@@ -190,6 +250,13 @@ def toggle(scene, view_layer):
         hide_originals(scene, view_layer, sorted(sources))
         show_results(scene, True)
         show_in_views(scene)
+
+
+def anything_to_remove(scene):
+    """Whether Remove Result has anything to remove: result objects, or an
+    attribute written on an original."""
+    return bool(result_objects(scene)) or any(
+        o.type == 'MESH' and o.data.get(ORIGINAL_ATTRIBUTE_TAG) for o in scene.objects)
 
 
 def clear(scene, view_layer):

@@ -56,7 +56,7 @@ class SceneTransaction:
                                              obj.data.get(ORIGINAL_ATTRIBUTE_TAG))
         self.shading = [(space, space.shading.color_type, space.shading.light,
                          space.shading.show_backface_culling) for space in _views()]
-        self.saved_views = scene.get(result_state.VIEWS_TAG)
+        self.saved_views = result_state.views_record(scene)
         return self
 
     def retire_results(self):
@@ -143,10 +143,7 @@ class SceneTransaction:
         for space, colour, light, culling in self.shading:
             shading = space.shading
             shading.color_type, shading.light, shading.show_backface_culling = colour, light, culling
-        if self.saved_views is None:
-            self.scene.pop(result_state.VIEWS_TAG, None)
-        else:
-            self.scene[result_state.VIEWS_TAG] = self.saved_views
+        result_state.put_views_record(self.scene, self.saved_views)
 
 
 def _copy_attribute(attr):

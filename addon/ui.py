@@ -1,10 +1,12 @@
-"""The Radiosity panels in Properties > Render, and the add-on's menu entries.
+"""The Radiosity panels in Properties > Render and in the 3D view's sidebar, and
+the add-on's menu entries.
 
 The parent panel holds the Solve button (with a progress bar while a solve
 runs) and Toggle / Remove; its sub-panels hold the settings (Quality and
 Limits, Output) and the last solve's Statistics. Solve, Toggle and Remove are
 also in the Render menu and in the 3D view's View > Radiosity menu, which is
-where F3 search finds them.
+where F3 search finds them. The sidebar's Radiosity tab (N) holds Solve, the
+oracle and quality, Toggle and Remove.
 
 Drawing only reads settings and the running solve's progress; it never changes
 data or calls operators. It is cheap: the operator redraws the panel while a
@@ -19,7 +21,7 @@ import bpy
 from bpy.props import FloatProperty
 from bpy.types import Menu, Panel
 
-from . import compat, native, operators, result_state, solve_reuse
+from . import compat, native, operators, pipeline, result_state, solve_reuse
 from .progress_text import progress_fraction, progress_texts
 from .quality_meaning import quality_text
 
@@ -131,6 +133,49 @@ def result_selected(context):
     return any(o.get(result_state.RESULT_TAG) for o in objects.selected)
 
 
+def toggle_icon(scene):
+    """Toggle's eye: open while the result is shown, closed while the originals are."""
+    return 'HIDE_OFF' if result_state.result_shown(scene) else 'HIDE_ON'
+
+
+def draw_solve(layout, context):
+    """Solve with the running solve's progress, Toggle and Remove, and what
+    stops the add-on from working or warns about edits."""
+    col = layout.column()
+    row = col.row()
+    row.scale_y = 1.5
+    row.operator("radiosity.solve", icon='LIGHT_AREA')
+    progress = operators.running_progress()
+    if progress is not None:
+        draw_progress(col, context, progress)
+    # Side by side where they fit, else one above the other.
+    flow = layout.grid_flow(row_major=True, columns=0, even_columns=True, align=True)
+    flow.operator("radiosity.toggle_result", text="Toggle Result", icon=toggle_icon(context.scene))
+    flow.operator("radiosity.clear", text="Remove Result", icon='X')
+    advice = native.advice()
+    if advice is not None:
+        box = layout.box()
+        box.alert = True
+        box.label(text="Solver failed to load", icon='ERROR')
+        draw_wrapped(box, context, advice, indent=BOX_PAD)
+    if result_selected(context):
+        box = layout.box()
+        draw_wrapped(box, context, EDIT_WARNING, icon='ERROR', indent=BOX_PAD)
+
+
+def draw_oracle_and_quality(layout, settings):
+    """The oracle, the Quality slider and what it means for that oracle."""
+    col = layout.column()
+    col.prop(settings, "oracle")
+    col.prop(settings, "quality", slider=True)
+    meaning = quality_text(settings, native.loaded())
+    if meaning:
+        row = col.row()
+        row.alignment = 'RIGHT'
+        row.label(text=meaning)
+    return col
+
+
 class RENDER_PT_radiosity(RadiosityPanel, Panel):
     """Solve, the progress of a running solve, and the result's Toggle and Remove"""
 
@@ -142,27 +187,30 @@ class RENDER_PT_radiosity(RadiosityPanel, Panel):
         return context.scene is not None
 
     def draw(self, context):
+        draw_solve(self.layout, context)
+
+
+class VIEW3D_PT_radiosity(Panel):
+    """Solve, the result's Toggle and Remove, the oracle and quality, in the
+    3D view's sidebar (N), where tools like this are looked for; the rest of
+    the settings stay in Properties > Render"""
+
+    bl_label = "Radiosity"
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = "Radiosity"
+
+    @classmethod
+    def poll(cls, context):
+        return context.scene is not None
+
+    def draw(self, context):
         layout = self.layout
+        draw_solve(layout, context)
         col = layout.column()
-        row = col.row()
-        row.scale_y = 1.5
-        row.operator("radiosity.solve", icon='LIGHT_AREA')
-        progress = operators.running_progress()
-        if progress is not None:
-            draw_progress(col, context, progress)
-        # Side by side where they fit, else one above the other.
-        flow = layout.grid_flow(row_major=True, columns=0, even_columns=True, align=True)
-        flow.operator("radiosity.toggle_result", text="Toggle Result", icon='HIDE_OFF')
-        flow.operator("radiosity.clear", text="Remove Result", icon='X')
-        advice = native.advice()
-        if advice is not None:
-            box = layout.box()
-            box.alert = True
-            box.label(text="Solver failed to load", icon='ERROR')
-            draw_wrapped(box, context, advice, indent=BOX_PAD)
-        if result_selected(context):
-            box = layout.box()
-            draw_wrapped(box, context, EDIT_WARNING, icon='ERROR', indent=BOX_PAD)
+        col.use_property_split = True
+        col.use_property_decorate = False
+        draw_oracle_and_quality(col, context.scene.radiosity)
 
 
 class RENDER_PT_radiosity_quality(RadiosityPanel, Panel):
@@ -177,14 +225,7 @@ class RENDER_PT_radiosity_quality(RadiosityPanel, Panel):
         layout.use_property_split = True
         layout.use_property_decorate = False
 
-        col = layout.column()
-        col.prop(settings, "oracle")
-        col.prop(settings, "quality", slider=True)
-        meaning = quality_text(settings, native.loaded())
-        if meaning:
-            row = col.row()
-            row.alignment = 'RIGHT'
-            row.label(text=meaning)
+        col = draw_oracle_and_quality(layout, settings)
         col.prop(settings, "min_element_size")
 
         col = layout.column()
@@ -197,6 +238,26 @@ class RENDER_PT_radiosity_quality(RadiosityPanel, Panel):
         col.prop(settings, "max_elements")
         col.prop(settings, "time_budget")
         col.prop(settings, "bounces")
+        unset = unset_limits_text(settings)
+        if unset:
+            draw_wrapped(layout, context, unset, icon='INFO')
+
+
+# What a setting left at 0 means, in words (Blender shows the number only):
+# (meaning, the settings it is the meaning of).
+ZERO_MEANS = (("no limit", ("max_elements", "time_budget")), ("automatic", ("min_element_size",)),
+              ("until converged", ("bounces",)))
+
+
+def unset_limits_text(settings):
+    """What the settings at 0 mean ("Elements, Time Limit at 0: no limit. ..."),
+    or "" when none is."""
+    parts = []
+    for meaning, names in ZERO_MEANS:
+        labels = [settings.bl_rna.properties[n].name for n in names if getattr(settings, n) == 0]
+        if labels:
+            parts.append("%s at 0: %s." % (", ".join(labels), meaning))
+    return " ".join(parts)
 
 
 class RENDER_PT_radiosity_output(RadiosityPanel, Panel):
@@ -253,7 +314,7 @@ def draw_stats(layout, context, stats):
     col = layout.column(align=True)
     for name, value in (("Oracle", stats.oracle),
                         ("Elements", "{:,}".format(stats.elements)),
-                        ("Links", "{:,}".format(stats.links)),
+                        ("Links", "{:,}".format(stats.links) if stats.links else "None"),
                         ("Iterations", "%d" % stats.iterations),
                         ("Time", "%.2f s" % stats.seconds)):
         split = col.split(factor=0.4)
@@ -261,8 +322,19 @@ def draw_stats(layout, context, stats):
         left.alignment = 'RIGHT'
         left.label(text=name)
         split.label(text=value)
+    if no_links_text(stats):
+        draw_wrapped(layout, context, no_links_text(stats), icon='INFO')
     if stats.warning:
         draw_wrapped(layout, context, stats.warning, icon='ERROR')
+
+
+def no_links_text(stats):
+    """Why a solve has no links ("Links 0" alone read as a failure), or ""."""
+    if stats.links:
+        return ""
+    if stats.status == pipeline.STATUS["quality"]:
+        return "No links: no two surfaces see each other, all light comes straight from the lights"
+    return "No links: the solve stopped before it linked any surfaces"
 
 
 # --- Menus: the Render menu and the 3D view's View menu, where F3 finds them -----------

@@ -30,6 +30,7 @@ ADDON_TYPES = (
     (bpy.types.Panel, "RENDER_PT_radiosity_quality"),
     (bpy.types.Panel, "RENDER_PT_radiosity_output"),
     (bpy.types.Panel, "RENDER_PT_radiosity_stats"),
+    (bpy.types.Panel, "VIEW3D_PT_radiosity"),
     (bpy.types.Menu, "VIEW3D_MT_radiosity"),
 )
 PANELS = (ui.RENDER_PT_radiosity, ui.RENDER_PT_radiosity_quality, ui.RENDER_PT_radiosity_output,
@@ -356,6 +357,50 @@ class PanelTest(unittest.TestCase):
         self.assertIn("Relit: only the lighting had changed", " ".join(relit))
         self.assertIn("Linked anew: the geometry changed", " ".join(layout.record["labels"]))
         self.assert_fits(layout)
+
+    def test_sidebar_tab_solves_and_sets_quality(self):
+        # The 3D view's sidebar (N) has a Radiosity tab: Solve first, Toggle
+        # and Remove, the oracle and quality with what the quality means.
+        panel = bpy.types.VIEW3D_PT_radiosity
+        self.assertEqual((panel.bl_space_type, panel.bl_region_type, panel.bl_category),
+                         ('VIEW_3D', 'UI', "Radiosity"))
+        self.assertTrue(ui.VIEW3D_PT_radiosity.poll(bpy.context))
+        layout = self.draw(ui.VIEW3D_PT_radiosity)
+        self.assertEqual(layout.record["operators"], MENU_OPERATORS)
+        self.assertEqual([name for _, name in layout.record["props"]], ["oracle", "quality"])
+        kind, column = layout._items[0]
+        self.assertEqual(column._items[0][1]._items[0][1:3], ("button", "Solve Radiosity"))
+        self.assert_fits(layout)
+
+    def test_settings_at_zero_say_what_zero_means(self):
+        settings = bpy.context.scene.radiosity
+        limits = self.draw(ui.RENDER_PT_radiosity_quality, width=600).record["labels"]
+        self.assertIn("Elements, Time Limit at 0: no limit. Min Size at 0: automatic. "
+                      "Iterations at 0: until converged.", " ".join(limits))
+        settings.max_elements, settings.bounces = 5000, 3
+        try:
+            limits = " ".join(self.draw(ui.RENDER_PT_radiosity_quality, width=600).record["labels"])
+            self.assertIn("Time Limit at 0: no limit. Min Size at 0: automatic.", limits)
+            self.assertNotIn("Elements", limits)
+            self.assertNotIn("Iterations", limits)
+        finally:
+            settings.property_unset("max_elements")
+            settings.property_unset("bounces")
+
+    def test_no_links_say_why(self):
+        stats = bpy.context.scene.radiosity.stats
+        stats.valid, stats.status, stats.links = True, "Converged", 0
+        try:
+            layout = self.draw(ui.RENDER_PT_radiosity_stats)
+            self.assertIn("None", layout.record["labels"])
+            self.assertIn("No links: no two surfaces see each other, all light comes straight from the lights",
+                          " ".join(layout.record["labels"]))
+            self.assert_fits(layout)
+            stats.status = "Time budget reached"
+            labels = " ".join(self.draw(ui.RENDER_PT_radiosity_stats).record["labels"])
+            self.assertIn("No links: the solve stopped before it linked any surfaces", labels)
+        finally:
+            stats.clear()
 
     def test_labels_fit_the_default_width(self):
         for panel in PANELS:
