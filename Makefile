@@ -2,12 +2,18 @@
 # each installs what is missing, builds, then does its job.
 BUILD      ?= build
 JOBS       ?= $(shell nproc)
-# Blenders by name (tools/blenders.py: 3.4 is Debian's, 4.5 and 5.0 are bpy from PyPI,
-# installed into $(BUILD)/blenders on first use) or by path. BLENDER runs demo,
+# Blenders by name (tools/blenders.py: 3.4 is Debian's, 4.5, 5.0 and 5.2 are bpy from
+# PyPI, installed into $(BUILD)/blenders on first use) or by path. BLENDER runs demo,
 # scenes and bench (and is asked for the Python version to build for); `make test`
-# runs tests/blender in each of BLENDERS, e.g. `make test BLENDERS=3.4` for a quick run.
+# runs all of tests/blender in each of BLENDERS (the oldest and the newest) and the
+# package-level check (install each zip, solve, bake, compare with Cycles) in each of
+# CHECK_BLENDERS, e.g. `make test BLENDERS=3.4 CHECK_BLENDERS=` for a quick run.
+# NATIVE_PYTHONS: the CPythons (tools/cpython.py) tests/native runs in besides Debian's
+# 3.11, each with the module built for it.
 BLENDER    ?= 3.4
-BLENDERS   ?= 3.4 4.5 5.0
+BLENDERS   ?= 3.4 5.2
+CHECK_BLENDERS ?= 4.5 5.0
+NATIVE_PYTHONS ?= 3.10 3.13
 PYTHON     ?= /usr/bin/python3
 SCENE      ?= office
 CMAKE_ARGS ?=
@@ -51,11 +57,12 @@ build: deps portable configure
 # Unit tests (CTest), Python tests of the native module and the packages, and the
 # headless Blender tests in each of $(BLENDERS), with one summary line at the end.
 test: build package blenders validator
-	@$(PYTHON) tests/run_tests.py --build $(BUILD) $(foreach b,$(BLENDERS),--blender $(b))
+	@$(PYTHON) tests/run_tests.py --build $(BUILD) $(foreach b,$(BLENDERS),--blender $(b)) \
+	    $(foreach b,$(CHECK_BLENDERS),--check-blender $(b)) $(foreach p,$(NATIVE_PYTHONS),--native-python $(p))
 
-# Installs each bpy of $(BLENDERS) that is missing (pinned; a no-op once there).
+# Installs each bpy of $(BLENDERS) and $(CHECK_BLENDERS) that is missing (pinned; a no-op once there).
 blenders:
-	@$(PYTHON) tools/blenders.py install --build $(BUILD) $(BLENDERS)
+	@$(PYTHON) tools/blenders.py install --build $(BUILD) $(BLENDERS) $(CHECK_BLENDERS)
 
 # The Khronos glTF validator (npm, pinned in tools/gltf_validator.py) in $(BUILD)/node,
 # for tests/blender/test_gltf_export.py (a no-op once there).

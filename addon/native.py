@@ -99,10 +99,13 @@ def version():
 
 
 def _built_for():
-    # The interpreter tag is part of the extension's file name
-    # (_radiosity.cpython-311-x86_64-linux-gnu.so), which survives a failed import.
-    for path in pathlib.Path(__file__).parent.glob("_radiosity*.so"):
-        match = re.search(r"cpython-(\d)(\d+)", path.name)
-        if match:
-            return "%s.%s" % match.groups()
-    return "an unknown version (no _radiosity*.so next to the add-on)"
+    # The interpreter tag is part of each module's file name
+    # (_radiosity.cpython-311-x86_64-linux-gnu.so), which survives a failed import;
+    # the package holds one module per Python version it serves.
+    versions = sorted({tuple(map(int, match.groups()))
+                       for path in pathlib.Path(__file__).parent.glob("_radiosity*.so")
+                       for match in [re.search(r"cpython-(\d)(\d+)", path.name)] if match})
+    if not versions:
+        return "an unknown version (no _radiosity*.so next to the add-on)"
+    names = ["%d.%d" % v for v in versions]
+    return names[0] if len(names) == 1 else "%s or %s" % (", ".join(names[:-1]), names[-1])

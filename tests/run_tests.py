@@ -5,18 +5,25 @@ Three kinds of tests, run in this order:
   ctest           the C++ unit tests registered with CTest in the build dir
   native/test_*   unittest files for the `_radiosity` module (and the study's
                   `_image_metric`), run by /usr/bin/python3 with build/addon/radiosity
-                  and build/study on sys.path (no Blender)
+                  and build/study on sys.path (no Blender); again in each CPython
+                  given (--native-python 3.10, repeatable: NATIVE_PYTHONS below, an
+                  environment of tools/cpython.py's CPython), which imports the
+                  add-on's module for its own version (native-3.10/test_solver.py)
   blender/test_*  unittest files run inside each Blender given (--blender, repeatable:
-                  3.4, 4.5, 5.0 of tools/blenders.py, installed when missing, or a path),
-                  `blender --background --factory-startup`, one process per file,
+                  3.4, 4.5, 5.0, 5.2 of tools/blenders.py, installed when missing, or a
+                  path), `blender --background --factory-startup`, one process per file,
                   with the add-on registered; the group is named after its Blender
-                  (blender-4.5/test_solve.py), so each failure names its Blender
+                  (blender-4.5/test_solve.py), so each failure names its Blender.
+                  A Blender given with --check-blender runs only the package-level
+                  check (PACKAGE_CHECK: install each zip, solve, bake, compare with
+                  a Cycles reference)
 
 One line per group (name, passed, failed, skipped, seconds), the output of
 failures, one line per Blender, and a last line `N passed, M failed`. Exits
 non-zero if anything failed, errored or crashed, or if nothing ran at all.
 
-    /usr/bin/python3 tests/run_tests.py --build build --blender 3.4 --blender 4.5 [-k PATTERN] [-v]
+    /usr/bin/python3 tests/run_tests.py --build build --blender 3.4 --check-blender 4.5 \
+        --native-python 3.10 [-k PATTERN] [-v]
 """
 
 import argparse
@@ -36,7 +43,20 @@ ROOT = Path(__file__).resolve().parent.parent
 TESTS = ROOT / "tests"
 sys.path.insert(0, str(ROOT / "tools"))
 import blenders  # noqa: E402  (the table of Blenders, tools/blenders.py)
+import cpython  # noqa: E402  (CPython versions from jars, tools/cpython.py)
+import venvs  # noqa: E402  (their environments, tools/venvs.py)
 RUNNER = TESTS / "unittest_runner.py"
+# The CPython versions tests/native runs in besides /usr/bin/python3 (3.11), each
+# with the add-on's module built for it: version -> pip requirements of its
+# environment (BUILD/pythons/env-VERSION). tomli: tomllib is 3.11's.
+NATIVE_PYTHONS = {
+    "3.10": ["numpy==1.26.4", "tomli==2.0.1"],
+    "3.13": ["numpy==2.5.5"],
+}
+# Files that need what only Debian's Python has: the study's _image_metric.
+NATIVE_ONLY_DEBIAN = {"test_image_metric.py"}
+# The package-level check of a --check-blender Blender.
+PACKAGE_CHECK = {"test_package.py"}
 LOG_TAIL = 80  # lines of a crashed process' output worth showing
 
 
@@ -54,8 +74,13 @@ def parse_args():
     parser.add_argument("--blender", dest="blenders", action="append", default=[],
                         help="a Blender to run tests/blender in: %s (tools/blenders.py) or a path; "
                              "repeatable (default: 3.4)" % ", ".join(blenders.BLENDERS))
+    parser.add_argument("--check-blender", dest="check_blenders", action="append", default=[],
+                        help="a Blender to run only the package-level check in (%s); repeatable"
+                             % ", ".join(sorted(PACKAGE_CHECK)))
     parser.add_argument("--python", default="/usr/bin/python3",
                         help="interpreter for tests/native (Blender's Python version)")
+    parser.add_argument("--native-python", dest="native_pythons", action="append", default=[],
+                        choices=NATIVE_PYTHONS, help="also run tests/native in this CPython; repeatable")
     parser.add_argument("-k", dest="patterns", action="append", default=[],
                         help="run only groups or tests whose name matches: a substring, "
                              "or a glob if it has '*' (repeatable; a test runs if any matches)")
@@ -220,12 +245,18 @@ def pattern_options(patterns):
 
 def python_jobs(args, build, tmp):
     """(name, Blender label or None, command, json path) of every selected Python test file."""
-    kinds = [("native", None, args.python, native_command)]
-    kinds += [("blender-%s" % label, label, exe, blender_command) for label, exe in args.blender_exes]
+    everything = lambda testfile: True  # noqa: E731
+    kinds = [("native", None, args.python, native_command, everything)]
+    kinds += [("native-%s" % version, None, python, native_command,
+               lambda testfile: testfile.name not in NATIVE_ONLY_DEBIAN)
+              for version, python in args.native_exes]
+    kinds += [("blender-%s" % label, label, exe, blender_command,
+               everything if full else lambda testfile: testfile.name in PACKAGE_CHECK)
+              for label, exe, full in args.blender_exes]
     jobs = []
-    for group, label, program, make_cmd in kinds:
-        folder = TESTS / ("native" if label is None else "blender")
-        for testfile in sorted(folder.glob("test_*.py")):
+    for group, label, program, make_cmd, selected in kinds:
+        folder = TESTS / ("blender" if label else "native")
+        for testfile in filter(selected, sorted(folder.glob("test_*.py"))):
             name = "%s/%s" % (group, testfile.name)
             json_out = str(Path(tmp) / (name.replace("/", "__") + ".json"))
             # A pattern naming the file runs all of it; otherwise the runner filters test ids.
@@ -235,11 +266,22 @@ def python_jobs(args, build, tmp):
 
 
 def resolve_blenders(args, build):
-    """[(label, executable)] of the Blenders asked for, installing a missing bpy first."""
+    """[(label, executable, whole suite?)] of the Blenders asked for, installing a missing bpy first."""
     found = []
-    for name in args.blenders or ["3.4"]:
+    asked = [(name, True) for name in args.blenders or ([] if args.check_blenders else ["3.4"])]
+    for name, full in asked + [(name, False) for name in args.check_blenders]:
         blenders.install(build, name)
-        found.append((name, blenders.executable(build, name)))
+        found.append((name, blenders.executable(build, name), full))
+    return found
+
+
+def resolve_pythons(args, build):
+    """[(version, interpreter)] of the --native-python environments, made when missing."""
+    found = []
+    for version in args.native_pythons:
+        folder = build / "pythons" / ("env-" + version)
+        venvs.make(folder, cpython.executable(build, version, "linux-x86_64"), NATIVE_PYTHONS[version])
+        found.append((version, str(venvs.python(folder))))
     return found
 
 
@@ -271,7 +313,8 @@ def main():
     build = Path(args.build).resolve()
     try:
         args.blender_exes = resolve_blenders(args, build)
-    except (blenders.BlenderError, subprocess.CalledProcessError) as err:
+        args.native_exes = resolve_pythons(args, build)
+    except (blenders.BlenderError, cpython.CPythonError, subprocess.CalledProcessError, OSError) as err:
         print("error: %s" % err)
         print("0 passed, 1 failed")
         return 1
@@ -291,7 +334,7 @@ def main():
                 outcome.blender = label
                 print_outcome(outcome)
                 outcomes.append(outcome)
-    print_blender_totals(outcomes, [label for label, _ in args.blender_exes])
+    print_blender_totals(outcomes, [label for label, _, _ in args.blender_exes])
     print("Python test files: %.1f s wall (-j %d)" % (time.perf_counter() - start, args.jobs))
 
     passed = sum(o.passed for o in outcomes)

@@ -1,21 +1,29 @@
-"""Blender side of test_package.py: install a package zip in this (clean) Blender, solve, report.
+"""Blender side of test_package.py: install a package zip in this (clean) Blender, solve,
+compare with Cycles, report.
 
-    blender -b --factory-startup --python install_and_solve.py -- extension|legacy ZIP SCENES_DIR
+    blender -b --factory-startup --python install_and_solve.py -- \
+        extension|legacy ZIP SCENES_DIR QUALITY REFERENCE_SAMPLES IMAGES_DIR
 
-Builds the bundled cube scene, installs ZIP with Blender's installer (extension:
+Builds the bundled cube scene with Lambertian materials and renders its Cycles
+reference (REFERENCE_SAMPLES), installs ZIP with Blender's installer (extension:
 into the "user_default" repository; legacy: the add-on installer), enables it,
-solves and prints one line "RESULT <json>".
+solves at QUALITY, renders the baked solution (16 samples, as test_cycles.py),
+saves both images as .npy in IMAGES_DIR and prints one line "RESULT <json>".
 """
 
 import importlib
 import json
+import os
 import sys
 
 import addon_utils
 import bpy
 import numpy as np
 
-KIND, ZIP, SCENES = sys.argv[sys.argv.index("--") + 1:][:3]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import render_compare as rc  # noqa: E402
+
+KIND, ZIP, SCENES, QUALITY, REFERENCE_SAMPLES, IMAGES = sys.argv[sys.argv.index("--") + 1:][:6]
 
 
 def install():
@@ -51,11 +59,16 @@ def main():
     # The scene first: starting an empty file resets the preferences, add-ons included.
     scene = scene_kit.empty_file()
     build_scene.build("cube", scene)
+    for material in bpy.data.materials:
+        scene_kit.make_lambertian(material)
+    reference = rc.render_image(scene, int(REFERENCE_SAMPLES))
     host_libraries = mapped_libraries()   # Blender's own, before the add-on loads
     module = install()
     package = importlib.import_module(module)
-    scene.radiosity.quality = 0.3
+    scene.radiosity.quality = float(QUALITY)
     assert bpy.ops.radiosity.solve() == {'FINISHED'}
+    np.save(os.path.join(IMAGES, "reference.npy"), reference)
+    np.save(os.path.join(IMAGES, "solution.npy"), rc.render_image(scene, 16))
     results = [o for o in scene.objects if o.get("radiosity_result")]
     values = []
     for obj in results:

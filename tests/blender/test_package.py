@@ -5,9 +5,13 @@ clean, empty user folder (BLENDER_USER_RESOURCES, and BLENDER_USER_SCRIPTS for
 3.x), installs a zip through Blender's own installer, enables it, builds the
 bundled cube scene (scenes/), solves it and reports, as one JSON line: where
 the add-on and its compiled module were loaded from, which shared libraries the
-process mapped before and after, and the baked attribute's values. The tests
-assert that all of it came from the installed package, not from the build tree
-or the system.
+process mapped before and after, and the baked attribute's values; it also
+renders the baked solution and a path-traced Cycles reference of the scene.
+The tests assert that all of it came from the installed package, not from the
+build tree or the system, and that the solution agrees with the reference as
+test_cycles.py requires (its tolerances, quality and samples). This file is
+the package-level check `make test` runs in the Blenders between the oldest
+and the newest (tests/run_tests.py --check-blender).
 
 - The extension zip (Blender 4.2+): bpy.ops.extensions.package_install_files
   into the "user_default" repository. Skipped in Blenders without extensions.
@@ -22,8 +26,11 @@ import tempfile
 import unittest
 
 import bpy
+import numpy as np
 
 import radiosity
+import render_compare as rc
+import test_cycles
 
 BUILD = pathlib.Path(radiosity.__file__).resolve().parents[2]   # <build>/addon/radiosity/__init__.py
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -51,9 +58,12 @@ class InstalledPackageTest(unittest.TestCase):
         with tempfile.TemporaryDirectory(prefix="radiosity-user-") as user:
             env = dict(os.environ, BLENDER_USER_RESOURCES=user, BLENDER_USER_SCRIPTS=os.path.join(user, "scripts"),
                        BLENDER_USER_CONFIG=os.path.join(user, "config"))
+            images = os.path.join(user, "images")
+            os.mkdir(images)
             cmd = [bpy.app.binary_path, "-b", "--factory-startup", "--python-exit-code", "1",
                    "--python", str(HERE / "install_and_solve.py"), "--",
-                   kind, str(package_zip(kind)), str(ROOT / "scenes")]
+                   kind, str(package_zip(kind)), str(ROOT / "scenes"), str(test_cycles.QUALITY),
+                   str(test_cycles.REFERENCE_SAMPLES), images]
             proc = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600,
                                   stdin=subprocess.DEVNULL)
             log = proc.stdout[-3000:] + proc.stderr[-3000:]
@@ -62,6 +72,8 @@ class InstalledPackageTest(unittest.TestCase):
             self.assertTrue(lines, log)
             report = json.loads(lines[-1][len("RESULT "):])
             report["user"] = os.path.realpath(user)
+            report["solution"], report["reference"] = (np.load(os.path.join(images, name + ".npy"))
+                                                       for name in ("solution", "reference"))
             return report
 
     def check(self, report):
@@ -83,6 +95,12 @@ class InstalledPackageTest(unittest.TestCase):
         self.assertTrue(report["finite"])
         self.assertGreater(report["max_radiance"], 0.1)
         self.assertGreaterEqual(report["min_radiance"], 0.0)
+        # The installed add-on's solution against the path-traced reference.
+        mean_error, region_error, _, _ = rc.compare(report["solution"], report["reference"])
+        print("[agreement] installed %s: mean %.1f %%, worst cell %.1f %% (%d elements)"
+              % (report["module"], 100 * mean_error, 100 * region_error, report["elements"]), flush=True)
+        self.assertLess(mean_error, test_cycles.MEAN_TOLERANCE)
+        self.assertLess(region_error, test_cycles.REGION_TOLERANCE)
 
     @unittest.skipUnless(has_extensions(), "this Blender has no extensions (4.2+)")
     def test_extension_zip(self):

@@ -1,14 +1,19 @@
 """The compiled `_radiosity` module loads in plain Python and says which version it is.
 
 Run by tests/run_tests.py with build/addon/radiosity on sys.path, under Debian's
-/usr/bin/python3 (the interpreter Blender runs), without Blender.
+/usr/bin/python3 (the interpreter Blender runs), without Blender, and under each
+CPython of --native-python (3.10, 3.13), which loads the module built for it.
 """
 
 import pathlib
 import re
 import sys
-import tomllib
 import unittest
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10 (Blender 3.6 to 4.1): tomllib's original
+    import tomli as tomllib
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
@@ -27,6 +32,17 @@ class ModuleTest(unittest.TestCase):
         self.assertEqual(path.parent.name, "radiosity", "expected build/addon/radiosity/")
         tag = "cpython-%d%d" % sys.version_info[:2]
         self.assertIn(tag, path.name, "module built for another Python than this one")
+
+    def test_addon_sources_compile_in_this_python(self):
+        """Every Python file of the assembled add-on is valid in this interpreter's
+        version (3.10 for Blender 3.6 to 4.0, 3.13 for 5.1 and later)."""
+        import _radiosity
+
+        sources = sorted(pathlib.Path(_radiosity.__file__).parent.glob("*.py"))
+        self.assertIn("__init__.py", [p.name for p in sources])
+        for path in sources:
+            with self.subTest(path.name):
+                compile(path.read_text(encoding="utf-8"), str(path), "exec")
 
     def test_version_matches_project_and_addon(self):
         import _radiosity

@@ -9,6 +9,8 @@ ldd on the files inside the extension zip.
   The portable build (native/portable) links Embree, TBB and libc++ into the
   module, so it needs glibc alone.
 - No libpython: the interpreter that imports the module provides it.
+- One module per CPython version of tools/cpython.py (3.10, 3.11, 3.13), each
+  named with its version's suffix; the one of the Python running the test loads.
 - The symbol versions they require from the system are within manylinux_2_28:
   glibc 2.28, GLIBCXX 3.4.24, CXXABI 1.3.11, GCC 7 (Blender's own Linux builds
   need glibc 2.28 too). A local build made with PORTABLE=OFF (Debian's Embree
@@ -22,15 +24,21 @@ import re
 import subprocess
 import sys
 import tempfile
-import tomllib
 import unittest
 import zipfile
 from pathlib import Path
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10 (Blender 3.6 to 4.1): tomllib's original
+    import tomli as tomllib
 
 import _radiosity
 
 ADDON = Path(_radiosity.__file__).resolve().parent          # <build>/addon/radiosity
 BUILD = ADDON.parent.parent
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tools"))
+import cpython  # noqa: E402  (the CPython versions the modules are built for)
 
 # Sonames the package may take from the system (auditwheel's manylinux whitelist,
 # less what the module does not use).
@@ -111,7 +119,9 @@ class PackagedModuleTest(unittest.TestCase):
 
     def test_package_has_the_module_and_its_libraries(self):
         names = sorted(p.relative_to(self.root).as_posix() for p in self.elves)
-        self.assertEqual(len([n for n in names if n.startswith("_radiosity.cpython-")]), 1, names)
+        modules = {"_radiosity.cpython-%s-x86_64-linux-gnu.so" % v.replace(".", "") for v in cpython.VERSIONS}
+        self.assertEqual({n for n in names if n.startswith("_radiosity.")}, modules, names)
+        self.assertIn(Path(_radiosity.__file__).name, modules)
         self.assertFalse([n for n in names if "image_metric" in n or "OpenImageIO" in n], names)
         print("[package] %s" % ", ".join("%s (%.1f MB)" % (n, (self.root / n).stat().st_size / 1e6)
                                          for n in names), flush=True)
