@@ -8,7 +8,8 @@ Three kinds of tests, run in this order:
                   and build/study on sys.path (no Blender); again in each CPython
                   given (--native-python 3.10, repeatable: NATIVE_PYTHONS below, an
                   environment of tools/cpython.py's CPython), which imports the
-                  add-on's module for its own version (native-3.10/test_solver.py)
+                  add-on's module for its own version (native-3.10/test_module.py;
+                  but for NATIVE_ONCE, the solver's numerics, the same in each)
   blender/test_*  unittest files run inside each Blender given (--blender, repeatable:
                   3.4, 4.5, 5.0, 5.2 of tools/blenders.py, installed when missing, or a
                   path), `blender --background --factory-startup`, one process per file,
@@ -53,8 +54,16 @@ NATIVE_PYTHONS = {
     "3.10": ["numpy==1.26.4", "tomli==2.0.1"],
     "3.13": ["numpy==2.5.5"],
 }
-# Files that need what only Debian's Python has: the study's _image_metric.
-NATIVE_ONLY_DEBIAN = {"test_image_metric.py"}
+# tests/native files run in Debian's Python alone, not again in NATIVE_PYTHONS. The
+# modules differ only in their bindings (native/python, compiled per version); the
+# solver is one static library linked into each (native/portable), so the files
+# that test its numerics through few calls run once. The fuzz slice, the API's
+# errors, arrays, threads, relighting's kept state and the package run in every Python.
+NATIVE_ONCE = {
+    "test_image_metric.py": "the study's _image_metric is built for Debian's Python alone",
+    "test_solver.py": "the solver's numerics", "test_energy.py": "the solver's energy balance",
+    "test_contact.py": "the solver's contact meshing",
+}
 # The package-level check of a --check-blender Blender.
 PACKAGE_CHECK = {"test_package.py"}
 LOG_TAIL = 80  # lines of a crashed process' output worth showing
@@ -248,7 +257,7 @@ def python_jobs(args, build, tmp):
     everything = lambda testfile: True  # noqa: E731
     kinds = [("native", None, args.python, native_command, everything)]
     kinds += [("native-%s" % version, None, python, native_command,
-               lambda testfile: testfile.name not in NATIVE_ONLY_DEBIAN)
+               lambda testfile: testfile.name not in NATIVE_ONCE)
               for version, python in args.native_exes]
     kinds += [("blender-%s" % label, label, exe, blender_command,
                everything if full else lambda testfile: testfile.name in PACKAGE_CHECK)
