@@ -62,7 +62,7 @@ NATIVE_PYTHONS = {
 NATIVE_ONCE = {
     "test_image_metric.py": "the study's _image_metric is built for Debian's Python alone",
     "test_solver.py": "the solver's numerics", "test_energy.py": "the solver's energy balance",
-    "test_contact.py": "the solver's contact meshing",
+    "test_contact.py": "the solver's contact meshing", "test_format.py": "the C++ sources' format",
 }
 # The package-level check of a --check-blender Blender.
 PACKAGE_CHECK = {"test_package.py"}
