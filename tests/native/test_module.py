@@ -30,7 +30,8 @@ class ModuleTest(unittest.TestCase):
 
         path = pathlib.Path(_radiosity.__file__)
         self.assertEqual(path.parent.name, "radiosity", "expected build/addon/radiosity/")
-        tag = "cpython-%d%d" % sys.version_info[:2]
+        # Windows (the Windows module, run under Wine): _radiosity.cp311-win_amd64.pyd
+        tag = ("cp%d%d-" if sys.platform == "win32" else "cpython-%d%d") % sys.version_info[:2]
         self.assertIn(tag, path.name, "module built for another Python than this one")
 
     def test_addon_sources_compile_in_this_python(self):
