@@ -49,6 +49,20 @@ def pass_printer():
     return progress
 
 
+def redraw_panels(context):
+    """Redraws the panels that show the progress (Properties, the 3D view's
+    sidebar) with the status bar, not the 3D views themselves: a view's redraw
+    costs as much as the solve under software OpenGL (_show_status), and the panel
+    froze at one pass's value while the status bar went on to the next."""
+    for area in context.screen.areas if context.screen else ():
+        if area.type == 'PROPERTIES':
+            area.tag_redraw()
+        elif area.type == 'VIEW_3D':
+            for region in area.regions:
+                if region.type == 'UI':
+                    region.tag_redraw()
+
+
 class RADIOSITY_OT_solve(Operator):
     """Compute the diffuse lighting of the scene with hierarchical radiosity and bake it into colour attributes"""
 
@@ -168,6 +182,7 @@ class RADIOSITY_OT_solve(Operator):
             self._status, self._status_time = text, now
             context.window_manager.progress_update(100.0 * float(progress.get("fraction", 0.0)))
             context.workspace.status_text_set(text + "  (Esc to cancel)")
+            redraw_panels(context)
 
     def _stop_modal(self, context):
         global _running_job

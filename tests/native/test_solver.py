@@ -513,6 +513,22 @@ class Cancellation(unittest.TestCase):
             for p in seen:
                 self.assertLessEqual(p["leaves"], p["elements"])
 
+    def test_progress_moves_within_each_pass(self):
+        # The bar stood still while a pass refined (full_office: one value
+        # while a pass went from 376 to 2,623 elements): within each pass the
+        # refining and gathering reports move the fraction on, below the
+        # pass's end.
+        b, _ = room_with_blocker()
+        for oracle in ORACLES:
+            seen = []
+            result = rad.solve(b.scene(rad), oracle=oracle, quality=0.5, progress=seen.append)
+            ends = {p["pass"]: p["fraction"] for p in seen if p["phase"] == "pass"}
+            self.assertEqual(len(ends), result.stats["passes"])
+            for k, end in ends.items():
+                within = {p["fraction"] for p in seen if p["pass"] == k and p["phase"] in ("refining", "gathering")}
+                self.assertGreaterEqual(len(within), 3, (oracle, k, sorted(within)))
+                self.assertLessEqual(max(within), end, (oracle, k))
+
     def test_each_pass_can_hand_over_its_solution(self):
         b, _ = room_with_blocker()
         seen = []

@@ -68,6 +68,8 @@ std::string_view phase_name(SolvePhase phase) {
       return "linking";
     case SolvePhase::Refining:
       return "refining";
+    case SolvePhase::Gathering:
+      return "gathering";
     case SolvePhase::Pass:
       return "pass";
     case SolvePhase::Done:

@@ -18,6 +18,7 @@
 #include "core/solve/energy_balance.h"
 #include "core/solve/gather.h"
 #include "core/solve/link_batch.h"
+#include "core/solve/pass_progress.h"
 #include "core/solve/refine.h"
 #include "core/solve/reuse.h"
 #include "core/solve/system_memory.h"
@@ -126,6 +127,9 @@ class Solver {
 
   void report(SolvePhase phase, double fraction, const SolveResult* pass_result = nullptr);
   double pass_fraction(double within) const;
+  std::size_t leaves() const {  // a split makes one leaf four
+    return hierarchy_.elements().size() - (hierarchy_.elements().size() - roots_) / 4;
+  }
   // Quality of each pass, coarse to fine (pass 0 refines nothing: quality 0).
   std::vector<double> pass_qualities() const;
   ClusterCriterion cluster_criterion(double quality, const ClusterLighting& lighting,
@@ -188,6 +192,7 @@ class Solver {
   std::vector<double> qualities_;      // one per pass (pass_qualities)
   int pass_ = 0, passes_ = 1;
   double fraction_ = 0.0;  // the last reported: progress never goes back
+  PassProgress pass_progress_;
   double threshold_ = std::numeric_limits<double>::infinity();
   bool complete_ = false;
   SolveStats stats_;
@@ -208,7 +213,7 @@ void Solver::report(SolvePhase phase, double fraction, const SolveResult* pass_r
     p.links = stats_.links;
   } else {
     p.elements = hierarchy_.elements().size();
-    p.leaves = p.elements - (p.elements - roots_) / 4;  // a split makes one leaf four
+    p.leaves = leaves();
     p.links = links_.size();
   }
   p.threshold = threshold_;
@@ -409,7 +414,8 @@ bool Solver::refine(double threshold) {
     links_ = std::move(round.kept);
     ++links_version_;
     track_memory();
-    report(SolvePhase::Refining, pass_fraction(0.5));
+    pass_progress_.refined(leaves());
+    report(SolvePhase::Refining, pass_fraction(pass_progress_.within()));
   }
   if (changed) {
     // Growth by doubling leaves up to half of each array unused until the next
@@ -519,6 +525,8 @@ double Solver::iterate(double threshold, int max_iterations, double tolerance, d
     stats_.seconds_gather += seconds_since(start);
     ++stats_.iterations;
     stats_.residual = residual;
+    pass_progress_.gathered(residual, tolerance, i + 1, max_iterations);
+    report(SolvePhase::Gathering, pass_fraction(pass_progress_.within()));
     if (std::isfinite(drift)) drift += residual;
     if (extrapolated) continue;  // not converged until an iteration confirms it
     // A pass cut short by the element budget is the last: converge it fully.
@@ -657,6 +665,7 @@ void Solver::solve_passes(double drift) {
   for (pass_ = 0; pass_ < passes_; ++pass_) {
     if (cancelled()) break;
     threshold_ = quality_threshold(options_.oracle, qualities_[static_cast<size_t>(pass_)]);
+    pass_progress_.start(leaves());
     const bool last = pass_ + 1 == passes_;
     if (options_.bounces) {
       iterate(threshold_, *options_.bounces, -1.0, drift);

@@ -92,9 +92,10 @@ struct SolveOptions {
 
 // What the solve is doing when it reports progress.
 enum class SolvePhase : std::uint8_t {
-  Linking,   // the initial links
-  Refining,  // a round of refinement made new links
-  Pass,      // a pass ended: its solution stands
+  Linking,    // the initial links
+  Refining,   // a round of refinement made new links
+  Gathering,  // an iteration gathered light over the links
+  Pass,       // a pass ended: its solution stands
   Done,
 };
 
