@@ -207,6 +207,25 @@ def gltf_exporter_properties():
     return None
 
 
+def exported_objects(context):
+    """The result objects of the context's scene in its view layer."""
+    view_layer = context.view_layer
+    return [o for o in result_state.result_objects(context.scene) if view_layer.objects.get(o.name) is not None]
+
+
+def why_not_exportable(context):
+    """Why the context's result cannot be exported, for the user; "" when it can."""
+    objects = exported_objects(context)
+    if not objects:
+        return "No radiosity result to export: solve with output New Meshes first"
+    not_ready = [o.name for o in objects if not is_game_ready(o)]
+    if not_ready:
+        return ("The result holds HDR radiance, not display colours: tick Game-Ready Colours "
+                "(Radiosity > Output: Colours For Games) and solve again before exporting (%s)"
+                % ", ".join(not_ready[:3]))
+    return ""
+
+
 def export_gltf(context, filepath):
     """Write the result objects of the context's scene to `filepath` (.glb or .gltf;
     .glb added to another name). Returns (the objects written, the path); raises
@@ -214,13 +233,10 @@ def export_gltf(context, filepath):
     scene, view_layer = context.scene, context.view_layer
     if os.path.splitext(filepath)[1].lower() not in (".glb", ".gltf"):
         filepath += ".glb"
-    objects = [o for o in result_state.result_objects(scene) if view_layer.objects.get(o.name) is not None]
-    if not objects:
-        raise RuntimeError("No radiosity result to export: solve with output New Meshes first")
-    not_ready = [o.name for o in objects if not is_game_ready(o)]
-    if not_ready:
-        raise RuntimeError("The result holds HDR radiance, not display colours: tick Game-Ready "
-                           "Colours (Radiosity > Output: Colours For Games) and solve again before exporting (%s)" % ", ".join(not_ready[:3]))
+    problem = why_not_exportable(context)
+    if problem:
+        raise RuntimeError(problem)
+    objects = exported_objects(context)
     props = gltf_exporter_properties()
     if props is None:
         raise RuntimeError("The glTF exporter (io_scene_gltf2) is not available in this Blender")
@@ -271,7 +287,20 @@ class RADIOSITY_OT_export_gltf(Operator, ExportHelper):
 
     @classmethod
     def poll(cls, context):
-        return context.scene is not None and bool(result_state.result_objects(context.scene))
+        if context.scene is None:
+            return False
+        if not result_state.result_objects(context.scene):
+            cls.poll_message_set("No radiosity result to export")
+            return False
+        return True
+
+    def invoke(self, context, event):
+        # Refused before the file browser opens, not after the user chose a file.
+        problem = why_not_exportable(context)
+        if problem:
+            self.report({'ERROR'}, problem)
+            return {'CANCELLED'}
+        return ExportHelper.invoke(self, context, event)
 
     def execute(self, context):
         try:

@@ -5,7 +5,7 @@ The parent panel holds the Solve button (with a progress bar while a solve
 runs) and Toggle / Remove; its sub-panels hold the settings (Quality and
 Limits, Output) and the last solve's Statistics. Solve, Toggle and Remove are
 also in the Render menu and in the 3D view's View > Radiosity menu, which is
-where F3 search finds them. The sidebar's Radiosity tab (N) holds Solve, the
+where F3 search finds them; the glTF export of the result is in File > Export. The sidebar's Radiosity tab (N) holds Solve, the
 oracle and quality, Toggle and Remove.
 
 Drawing only reads settings and the running solve's progress; it never changes
@@ -359,6 +359,10 @@ def draw_render_menu(self, context):
     draw_operators(self.layout)
 
 
+def draw_export_menu(self, context):
+    self.layout.operator("radiosity.export_gltf", text="Radiosity Result (.glb/.gltf)")
+
+
 def draw_view_menu(self, context):
     # Beside Viewport Render: what the 3D view shows of the scene's lighting.
     self.layout.separator()
@@ -366,7 +370,8 @@ def draw_view_menu(self, context):
 
 
 # (menu, draw function) pairs that register() appends and unregister() removes.
-MENU_ENTRIES = (("TOPBAR_MT_render", draw_render_menu), ("VIEW3D_MT_view", draw_view_menu))
+MENU_ENTRIES = (("TOPBAR_MT_render", draw_render_menu), ("VIEW3D_MT_view", draw_view_menu),
+                ("TOPBAR_MT_file_export", draw_export_menu))
 
 
 def register():

@@ -79,9 +79,11 @@ def draw_menu(name):
 
 
 def menu_entries():
-    """How often the Render menu holds Solve, and the View menu the Radiosity menu."""
+    """How often the Render menu holds Solve, the View menu the Radiosity menu and
+    File > Export the glTF export."""
     return (draw_menu("TOPBAR_MT_render")["operators"].count("radiosity.solve"),
-            draw_menu("VIEW3D_MT_view")["menus"].count("VIEW3D_MT_radiosity"))
+            draw_menu("VIEW3D_MT_view")["menus"].count("VIEW3D_MT_radiosity"),
+            draw_menu("TOPBAR_MT_file_export")["operators"].count("radiosity.export_gltf"))
 
 
 def settings_values(group):
@@ -110,7 +112,7 @@ class RegistrationTest(unittest.TestCase):
                 self.assertIsNone(registered_type(base, name), name)
                 self.assertFalse(hasattr(bpy.types, name), name)
             self.assertFalse(any(cls.is_registered for cls in radiosity.classes))
-            self.assertEqual(menu_entries(), (0, 0))
+            self.assertEqual(menu_entries(), (0, 0, 0))
             self.assertFalse(hasattr(bpy.types.WindowManager, "radiosity_progress"))
         finally:
             radiosity.register()
@@ -130,20 +132,20 @@ class RegistrationTest(unittest.TestCase):
             radiosity.register()
 
     def test_disable_enable_twice_leaves_one_menu_entry(self):
-        self.assertEqual(menu_entries(), (1, 1))
+        self.assertEqual(menu_entries(), (1, 1, 1))
         radiosity.unregister()
         try:
             for _ in range(2):
                 addon_utils.enable("radiosity", default_set=False, handle_error=self._raise)
-                self.assertEqual(menu_entries(), (1, 1))
+                self.assertEqual(menu_entries(), (1, 1, 1))
                 addon_utils.disable("radiosity", default_set=False, handle_error=self._raise)
-                self.assertEqual(menu_entries(), (0, 0))
+                self.assertEqual(menu_entries(), (0, 0, 0))
         finally:
             radiosity.register()
-        self.assertEqual(menu_entries(), (1, 1))
+        self.assertEqual(menu_entries(), (1, 1, 1))
         # A second register without unregister (a script's) adds no second entry either.
         ui.register()
-        self.assertEqual(menu_entries(), (1, 1))
+        self.assertEqual(menu_entries(), (1, 1, 1))
 
     @staticmethod
     def _raise(err):

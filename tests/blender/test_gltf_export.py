@@ -284,6 +284,34 @@ class ExportRefusalTest(unittest.TestCase):
         self.assertIn("Game-Ready Colours", str(ctx.exception))
         self.assertFalse(os.path.exists(path))
 
+    def test_hdr_result_is_refused_before_the_file_browser(self):
+        # Invoked from File > Export or the panel: refused with the same message
+        # before the file browser opens (ExportHelper.invoke), not after a file
+        # was chosen. Background Blender runs 'INVOKE_DEFAULT' as execute (it
+        # has no window), so invoke is called as the window would call it.
+        from bpy_extras.io_utils import ExportHelper
+        from radiosity import game_export
+        scene = open_cube()
+        solve(scene)
+        self.assertTrue(bpy.ops.radiosity.export_gltf.poll())
+        reports, browsed = [], []
+
+        class Invoked:
+            def report(self, kinds, message):
+                reports.append((kinds, message))
+
+        opens_the_browser = ExportHelper.invoke
+        ExportHelper.invoke = lambda op, context, event: browsed.append(op) or {'RUNNING_MODAL'}
+        try:
+            result = game_export.RADIOSITY_OT_export_gltf.invoke(Invoked(), bpy.context, None)
+        finally:
+            ExportHelper.invoke = opens_the_browser
+        self.assertEqual(result, {'CANCELLED'})
+        self.assertEqual(browsed, [])
+        self.assertEqual(len(reports), 1)
+        self.assertEqual(reports[0][0], {'ERROR'})
+        self.assertIn("Game-Ready Colours", reports[0][1])
+
     def test_no_result_no_export(self):
         open_cube()
         self.assertFalse(bpy.ops.radiosity.export_gltf.poll())
