@@ -9,9 +9,9 @@
 # - Windows: _radiosity.cp3XY-win_amd64.pyd, linked against python3XY.dll through the
 #   import library of that CPython (<deps>/libs/python3XY.lib, tools/cross_build.py);
 #   libc++ is in the module, the C runtime is the Universal CRT (api-ms-win-crt-*).
-# - macOS: _radiosity.cpython-3XY-darwin.so, a Mach-O bundle whose Python symbols
-#   are looked up when it loads (-undefined dynamic_lookup), exporting
-#   _PyInit__radiosity alone; libc++ is in the module, so it needs libSystem only.
+# - macOS: _radiosity.cpython-3XY-darwin.so, a Mach-O dylib whose Python symbols
+#   are looked up when it loads (-undefined dynamic_lookup); libc++ is in the
+#   module, so it needs libSystem only.
 # Every platform: no debug information (-s; the Linux module is 3 MB instead of 40).
 
 # Windows: <windows.h> without its min/max macros (std::numeric_limits<T>::max()),
@@ -31,8 +31,10 @@ function(radiosity_platform_module target tag)
     target_link_libraries(${target} PRIVATE ${RADIOSITY_DEPS}/libs/python${tag}.lib)
   elseif(CMAKE_SYSTEM_NAME STREQUAL "Darwin")
     set_target_properties(${target} PROPERTIES SUFFIX ".cpython-${tag}-darwin.so")
-    target_link_options(${target} PRIVATE -undefined dynamic_lookup
-                        -Wl,-exported_symbol,_PyInit__radiosity)
+    # zig's Mach-O linker makes no bundles (it ignores CMake's -bundle): a dylib, which
+    # Python loads the same way; nor does it take an export list: hidden visibility
+    # leaves PyInit__radiosity and libc++'s replaceable operator new and delete.
+    target_link_options(${target} PRIVATE -shared -undefined dynamic_lookup)
   else()
     set_target_properties(${target} PROPERTIES SUFFIX ".cpython-${tag}-x86_64-linux-gnu.so")
     # The static libraries' symbols stay inside: the module exports PyInit__radiosity alone.
