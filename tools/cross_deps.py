@@ -33,6 +33,25 @@ PLATFORMS = {
 ARM_ISA = ["-DEMBREE_ISA_NEON=ON", "-DEMBREE_ISA_NEON2X=OFF"]
 # MinGW's math.h declares M_PI, which Embree uses, only when asked to.
 WINDOWS_EMBREE = ["-DEMBREE_IGNORE_CMAKE_CXX_FLAGS=OFF", "-DCMAKE_CXX_FLAGS=-D_USE_MATH_DEFINES"]
+# Embree asks Windows for the privilege of large pages (ADVAPI32's token functions)
+# when it starts; the solver never uses large pages, and the module is to need no
+# DLL beyond KERNEL32 and the C runtime: on Windows it does not ask (Windows-only code).
+EMBREE_WINDOWS_FIXES = {
+    "common/sys/alloc.cpp": ("  bool win_enable_selockmemoryprivilege (bool verbose)\n  {\n    HANDLE hToken;",
+                             "  bool win_enable_selockmemoryprivilege (bool verbose)\n  {\n"
+                             "    return false;   // tools/cross_deps.py: no large pages, no ADVAPI32\n  }\n"
+                             "  static bool win_enable_selockmemoryprivilege_unused (bool verbose)\n  {\n"
+                             "    HANDLE hToken;"),
+}
+# oneTBB marks its functions __declspec(dllexport) under MinGW, also in a static
+# library, which would export them from the module: its export header is
+# pre-empted (guard and macros defined empty) for the Windows build.
+TBB_STATIC_EXPORTS = """// oneTBB's detail/_export.h for a static MinGW build (tools/cross_deps.py): nothing exported.
+#define __TBB_detail__export_H
+#define TBB_EXPORT
+#define TBBMALLOC_EXPORT
+#define TBBBIND_EXPORT
+"""
 # Windows: oneTBB's and Embree's version resources (tbb.rc, embree.rc) are compiled by zig's resource
 # compiler; nothing links it, as nothing references it in the static library.
 RC_WRAPPER = """#!/usr/bin/env python3
@@ -120,8 +139,30 @@ def embree_options(platform):
     if PLATFORMS[platform]["processor"] == "arm64":
         options = [o for o in options if not o.startswith("-DEMBREE_ISA_")] + ARM_ISA
     if PLATFORMS[platform]["system"] == "Windows":
-        options += WINDOWS_EMBREE
+        # The fixes' files named in the options: a build without them is not reused.
+        options += WINDOWS_EMBREE + ["-DRADIOSITY_CROSS_FIXES=%s" % ",".join(sorted(EMBREE_WINDOWS_FIXES))]
     return options
+
+
+def tbb_options(folder, platform):
+    options = list(portable_deps.TBB_OPTIONS)
+    if PLATFORMS[platform]["system"] == "Windows":
+        header = folder / "tbb_static_exports.h"
+        header.write_text(TBB_STATIC_EXPORTS)
+        options.append("-DCMAKE_CXX_FLAGS=-include %s" % header)
+    return options
+
+
+def fix_sources(source, fixes):
+    """Apply (old, new) replacements to files under `source`, once (a no-op when applied)."""
+    for rel, (old, new) in fixes.items():
+        path = source / rel
+        text = path.read_text()
+        if new in text:
+            continue
+        if old not in text:
+            sys.exit("error: %s changed; the fix for the cross build no longer applies" % path)
+        path.write_text(text.replace(old, new))
 
 
 def build(build_dir, platform):
@@ -133,7 +174,9 @@ def build(build_dir, platform):
     folder = folder_of(build_dir, platform)
     toolchain(build_dir, platform)
     start = time.perf_counter()
-    portable_deps.build_static(folder, "onetbb", src["onetbb"], portable_deps.TBB_OPTIONS)
+    if PLATFORMS[platform]["system"] == "Windows":
+        fix_sources(src["embree"], EMBREE_WINDOWS_FIXES)
+    portable_deps.build_static(folder, "onetbb", src["onetbb"], tbb_options(folder, platform))
     portable_deps.build_static(folder, "embree", src["embree"], embree_options(platform))
     log("%s: Embree and oneTBB ready in %s (%.0f s)" % (platform, folder, time.perf_counter() - start))
     return folder
