@@ -9,7 +9,8 @@ length 35 mm, film 25 x 25 mm) and the measured reflectance spectra (white,
 green, red; 400-700 nm in 4 nm steps; all surfaces Lambertian) and the light's
 emission spectrum (0, 8, 15.6, 18.4 at 400, 500, 600, 700 nm). As published:
 the floor is 3.2 mm wider at the front than at the back, the left (red) wall
-is a slightly non-planar quad, the blocks have five faces each (no bottom)
+is a slightly non-planar quad (here its two triangles, as Blender renders it,
+so that every face is planar), the blocks have five faces each (no bottom)
 and stand on the floor, and the front of the box is open (a black world
 outside). The published light lies in the ceiling's plane; here it hangs
 `gap` below it (a mesh with an Emission shader, which Cycles lets emit from
@@ -73,23 +74,33 @@ def to_blender(points_mm):
 
 
 def add_faces(scene, name, faces_mm, material, drop=0.0):
-    """One object of the given published quads, its origin at its centre (so the
-    object's location says where it is), moved down by `drop` metres."""
-    corners = to_blender(np.array(faces_mm, dtype=float).reshape(-1, 3))
+    """One object of the given published polygons, its origin at its centre (so
+    the object's location says where it is), moved down by `drop` metres."""
+    sizes = [len(face) for face in faces_mm]
+    corners = to_blender(np.array([corner for face in faces_mm for corner in face], dtype=float))
     # Corners shared by a block's faces become one vertex (a connected mesh).
     verts, index = np.unique(np.round(corners, 9), axis=0, return_inverse=True)
+    starts = np.cumsum([0] + sizes)
+    faces = [index.reshape(-1)[a:b].tolist() for a, b in zip(starts[:-1], starts[1:])]
     centre = verts.mean(axis=0)
-    return kit.add_mesh(scene, name, (verts - centre, index.reshape(-1, 4)), material,
+    return kit.add_mesh(scene, name, (verts - centre, faces), material,
                         location=tuple(centre - np.array([0.0, 0.0, drop])))
+
+
+def as_triangles(quad):
+    """A non-planar quad as the two triangles Blender renders it as (corners 0 1 2
+    and 0 2 3), so that the mesh is the published surface with planar faces."""
+    return [(quad[0], quad[1], quad[2]), (quad[0], quad[2], quad[3])]
 
 
 def build(scene, gap=GAP):
     white = kit.lambertian_material("White", WHITE)
     red = kit.lambertian_material("Red", RED)
     green = kit.lambertian_material("Green", GREEN)
-    for name, face, mat in (("Floor", FLOOR, white), ("Ceiling", CEILING, white), ("Wall.Back", BACK_WALL, white),
-                            ("Wall.Right", RIGHT_WALL, green), ("Wall.Left", LEFT_WALL, red)):
-        add_faces(scene, name, [face], mat)
+    for name, faces, mat in (("Floor", [FLOOR], white), ("Ceiling", [CEILING], white),
+                             ("Wall.Back", [BACK_WALL], white), ("Wall.Right", [RIGHT_WALL], green),
+                             ("Wall.Left", as_triangles(LEFT_WALL), red)):
+        add_faces(scene, name, faces, mat)
     add_faces(scene, "Block.Short", SHORT_BLOCK, white)
     add_faces(scene, "Block.Tall", TALL_BLOCK, white)
     # Colour inputs are kept within [0, 1]: the colour's brightest channel goes into the strength.

@@ -22,6 +22,7 @@ from radiosity import bake, native, operators, pipeline, result_state, solve_reu
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "scenes")))
 import build_scene  # noqa: E402
+import catalog  # noqa: E402
 from test_addon import scene_snapshot  # noqa: E402
 
 ADDON_DIR = os.path.dirname(os.path.dirname(os.path.abspath(bake.__file__)))
@@ -84,6 +85,21 @@ def results(scene):
 
 def luminance(rgb):
     return rgb @ np.array([0.2126, 0.7152, 0.0722])
+
+
+class BundledScenesTest(unittest.TestCase):
+    def test_bundled_scenes_solve_without_warnings(self):
+        # What a user opens first must not warn on every solve: full_office
+        # named its chair's back on its seat as "faces in the same place"
+        # (solids touching, not a doubled surface), the Cornell box its
+        # published non-planar wall as repaired.
+        for name in (*catalog.SCENES, *catalog.CONTACT_SCENES, *catalog.LIGHT_SCENES):
+            with self.subTest(scene=name):
+                scene = open_scene(name)
+                scene.radiosity.quality = 0.0
+                self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
+                self.assertTrue(scene.radiosity.stats.valid)
+                self.assertEqual(scene.radiosity.stats.warning, "")
 
 
 class SolveCubeTest(unittest.TestCase):

@@ -580,6 +580,7 @@ void mesh_contacts(Scene& scene) {
     for (size_t k = 0; k < cut[p].size(); ++k) {
       Piece& piece = cut[p][k];
       std::int64_t target = -1;
+      std::uint32_t found_in = 0;  // the patch of the piece it coincides with
       for (std::uint32_t q : piece.coincides_with) {
         if (q >= p) break;  // sorted: only earlier patches
         const double tolerance = kThinnest * std::max(diameter[p], diameter[q]);
@@ -590,12 +591,17 @@ void mesh_contacts(Scene& scene) {
             target = static_cast<std::int64_t>(first_piece[q] + m);
         }
         if (target >= 0) {
-          coincident.push_back({std::min(patches[p].sides[0].face, patches[q].sides[0].face),
-                                std::max(patches[p].sides[0].face, patches[q].sides[0].face)});
+          found_in = q;
           break;
         }
       }
       if (target < 0) continue;
+      // Named only where the two face the same way: the same surface twice
+      // (z-fighting). Faces facing each other are solids touching (a box on a
+      // floor, a board against a shelf's side), hidden between them.
+      if (glm::dot(patches[p].normal, patches[found_in].normal) > 0.0)
+        coincident.push_back({std::min(patches[p].sides[0].face, patches[found_in].sides[0].face),
+                              std::max(patches[p].sides[0].face, patches[found_in].sides[0].face)});
       target = resolve(target);
       Piece& into = *flat[static_cast<size_t>(target)];
       const size_t owner_patch = static_cast<size_t>(

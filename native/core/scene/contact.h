@@ -24,8 +24,8 @@
 // P's diameter that do not emit (a chair leg on a floor). Where Q lies in P's plane (within 1e-5 of
 // their diameters, or 1e-6 of the scene's), the two coincide there: the coinciding pieces become
 // one patch, with one side per direction (the emitting one, else the first
-// face's), so a doubled wall sends its light once; the pairs are listed in
-// Scene::coincident.
+// face's), so a doubled wall sends its light once; the pairs facing the same
+// way are listed in Scene::coincident.
 //
 // Candidate pairs come from a bounding volume hierarchy over the patches:
 // n log n in the faces, plus the pairs that really touch.

@@ -110,8 +110,10 @@ struct Scene {
   // Direct light that is not a surface: the scene's lights, then the sky when
   // the world is not black (lights.h, direct_light.h).
   std::vector<Light> lights;
-  // Pairs of input faces that coincide somewhere (the same surface twice, as
-  // z-fighting shows it); each is counted once (contact.h).
+  // Pairs of input faces that coincide somewhere facing the same way (the
+  // same surface twice, as z-fighting shows it); each is counted once
+  // (contact.h). Coinciding faces that face each other (solids touching) are
+  // merged alike but not listed.
   std::vector<std::array<std::uint32_t, 2>> coincident;
   std::size_t split_faces = 0;  // input faces split along what lies on or passes through them
   std::size_t face_count = 0;
