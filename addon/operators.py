@@ -38,6 +38,15 @@ def running_progress():
     return None if job is None else dict(job.progress)
 
 
+def refused_while_solving(operator):
+    """True (with the reason for the tooltip) while an interactive solve runs: its
+    passes and final bake own the result until it ends."""
+    if _running_job is None:
+        return False
+    operator.poll_message_set("A radiosity solve is running (Esc cancels it)")
+    return True
+
+
 def pass_printer():
     """A progress callback that prints one line per pass."""
     last = [None]
@@ -73,7 +82,7 @@ class RADIOSITY_OT_solve(Operator):
 
     @classmethod
     def poll(cls, context):
-        if context.scene is None:
+        if context.scene is None or refused_while_solving(cls):
             return False
         # In Edit Mode the mesh data blocks lag behind the edit meshes, so a
         # solve would silently use stale geometry.
@@ -245,6 +254,8 @@ class RADIOSITY_OT_toggle_result(Operator):
 
     @classmethod
     def poll(cls, context):
+        if refused_while_solving(cls):
+            return False
         return context.scene is not None and bool(result_state.result_objects(context.scene))
 
     def execute(self, context):
@@ -261,7 +272,7 @@ class RADIOSITY_OT_clear(Operator):
 
     @classmethod
     def poll(cls, context):
-        if context.scene is None:
+        if context.scene is None or refused_while_solving(cls):
             return False
         if not result_state.anything_to_remove(context.scene) and not context.scene.radiosity.stats.valid:
             cls.poll_message_set("No radiosity result to remove")

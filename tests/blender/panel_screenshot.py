@@ -136,9 +136,9 @@ def step():
             show_render_tab()
             solve()
         elif n in (1, 2):
-            # Twice: the panels' heights are known after a draw. Three steps back show
+            # Twice: the panels' heights are known after a draw. Six steps back show
             # the top of the Radiosity panel: the Solve button.
-            scroll_to_end(3)
+            scroll_to_end(6)
         elif n == 3:
             area = properties_area()
             state["result"]["region"] = [region(area).width, region(area).height]
@@ -157,7 +157,7 @@ def step():
                 results[0].select_set(True)
                 bpy.context.view_layer.objects.active = results[0]
         elif n in (5, 6):
-            scroll_to_end(6)  # the bar's rows and the warning make the panel taller
+            scroll_to_end(12)  # the bar's rows, the lock and the warning make the panel taller
         elif n == 7:
             screenshot("panel_progress.png")
             state["result"]["progress_api"] = hasattr(bpy.types.UILayout, "progress")

@@ -484,7 +484,24 @@ class PanelTest(unittest.TestCase):
         else:
             self.assertIn((bpy.context.window_manager, "radiosity_progress"), layout.record["props"])
         self.assertIn("Esc to cancel", layout.record["labels"])
+        self.assertIn(ui.SOLVING_LOCK, " ".join(layout.record["labels"]))
         self.assertEqual(layout.record["operators"][0], "radiosity.solve")
+
+    def test_solve_toggle_and_remove_wait_while_a_solve_runs(self):
+        bpy.ops.mesh.primitive_cube_add()
+        bpy.context.active_object["radiosity_result"] = "Cube"  # a result to toggle and remove
+        try:
+            self.assertTrue(bpy.ops.radiosity.solve.poll())
+            self.assertTrue(bpy.ops.radiosity.toggle_result.poll())
+            self.assertTrue(bpy.ops.radiosity.clear.poll())
+            operators._running_job = object()  # what an interactive solve sets while it runs
+            try:
+                for op in (bpy.ops.radiosity.solve, bpy.ops.radiosity.toggle_result, bpy.ops.radiosity.clear):
+                    self.assertFalse(op.poll(), op)
+            finally:
+                operators._running_job = None
+        finally:
+            bpy.data.objects.remove(bpy.context.active_object)
 
     def test_fallback_bar_while_solving(self):
         class WithoutProgress(CheckedLayout):
