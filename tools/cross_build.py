@@ -10,6 +10,8 @@ tools/cpython.py; Windows also its import library python3XY.lib), then
 native/portable configured with the platform's zig toolchain
 (native/portable/platform.cmake says what differs). macOS modules are then
 signed ad hoc with rcodesign (tools/rcodesign.py), as arm64 Macs require.
+Last, the solver's C++ unit tests for the platform (native/portable/unit_tests.cmake),
+in BUILD/cross/PLATFORM/build-module/unit-tests.
 
 JavaCPP publishes macosx-arm64 jars of CPython 3.13 only: the arm64 modules of
 3.10 and 3.11 are built against the macosx-x86_64 headers of that version.
@@ -106,7 +108,9 @@ def build_modules(build, platform, jobs):
                            "-DCMAKE_TOOLCHAIN_FILE=%s" % (folder / "zig.cmake"), "-DCMAKE_BUILD_TYPE=Release",
                            "-DRADIOSITY_DEPS=%s" % folder, "-DRADIOSITY_OUTPUT_DIR=%s" % modules_dir(build, platform),
                            "-DRADIOSITY_VERSION=%s" % version(), "-DRADIOSITY_UNIT_TESTS=ON"], folder / "module-configure.log")
-    portable_deps.run(["cmake", "--build", str(work), "-j", str(jobs)], folder / "module-build.log")
+    modules_targets = ["_radiosity_cp%s" % m.replace(".", "") for m in cpython.VERSIONS]
+    portable_deps.run(["cmake", "--build", str(work), "-j", str(jobs), "--target", *modules_targets],
+                      folder / "module-build.log")
     found = modules(build, platform)
     if platform.startswith("macos"):
         for path in found.values():
@@ -117,7 +121,18 @@ def build_modules(build, platform, jobs):
                                                                 folder / "module-build.log"))
     cross_deps.log("%s: %s (%.0f s)" % (platform, ", ".join(
         "%s %.1f MB" % (p.name, p.stat().st_size / 1e6) for p in found.values()), time.perf_counter() - start))
+    # Then the C++ unit tests for the platform (run under Wine for Windows, linked for macOS).
+    start = time.perf_counter()
+    portable_deps.run(["cmake", "--build", str(work), "-j", str(jobs), "--target", "radiosity_tests"],
+                      folder / "unit-tests-build.log")
+    cross_deps.log("%s: %s (%.0f s)" % (platform, unit_tests(build, platform), time.perf_counter() - start))
     return found
+
+
+def unit_tests(build, platform):
+    """The C++ unit tests' program built for `platform`."""
+    name = "radiosity_tests.exe" if platform == "windows-x64" else "radiosity_tests"
+    return cross_deps.folder_of(build, platform) / "build-module" / "unit-tests" / name
 
 
 def main():

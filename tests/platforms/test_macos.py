@@ -15,14 +15,15 @@ Mach-O file with LLVM's tools (llvm-objdump-16, llvm-nm-16) and rcodesign.
   (-undefined dynamic_lookup, flat lookup: Blender's Python provides them);
 - the libraries it loads: /usr/lib/libSystem.B.dylib and /usr/lib/libc++.1.dylib at most;
 - an ad hoc code signature that `rcodesign verify` accepts (arm64 Macs run no
-  unsigned code).
+  unsigned code);
+- and the solver's C++ unit tests, cross-built for each Mac, link.
 """
 
 import re
 import subprocess
 import unittest
 
-from packages import BUILD, PackageChecks, UnpackedZip
+from packages import BUILD, PackageChecks, UnpackedZip, cross_build
 
 import rcodesign  # tools/rcodesign.py (on sys.path through packages)
 
@@ -107,6 +108,26 @@ class MacPackageChecks(PackageChecks):
                 self.assertIn("LC_CODE_SIGNATURE", load_commands(path))
                 ok, output = rcodesign.verify(BUILD, path)
                 self.assertTrue(ok, output)
+
+
+class MacUnitTests(unittest.TestCase):
+    """The solver's C++ unit tests cross-built for each macOS (tools/cross_build.py): they
+    cannot run here, but they link: a Mach-O executable of that CPU type and macOS 11.0
+    that loads libSystem alone."""
+
+    def test_unit_tests_link_for_each_mac(self):
+        for platform, arch in (("macos-arm64", "ARM64"), ("macos-x64", "X86_64")):
+            with self.subTest(platform=platform):
+                path = cross_build.unit_tests(BUILD, platform)
+                self.assertTrue(path.exists(), "%s not built: make test-platforms" % path)
+                header = tool("llvm-objdump", "--macho", "--private-header", str(path))
+                self.assertRegex(header, r"MH_MAGIC_64\s+%s\s.*\sEXECUTE\s" % arch)
+                commands = load_commands(path)
+                self.assertRegex(commands, r"cmd LC_BUILD_VERSION.*?minos %s" % re.escape(MIN_MACOS))
+                dylibs = re.findall(r"cmd LC_LOAD_DYLIB\s+cmdsize \d+\s+name (\S+)", commands)
+                self.assertEqual(dylibs, ["/usr/lib/libSystem.B.dylib"])
+                print("[macos] %s's unit tests link: %s (%.1f MB)" % (platform, path.name, path.stat().st_size / 1e6),
+                      flush=True)
 
 
 class MacArm64PackageTest(MacPackageChecks, UnpackedZip):
