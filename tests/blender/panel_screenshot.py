@@ -13,6 +13,7 @@ scrolled to the add-on's panels at the end, and saves:
                               selected (the "edits are replaced" warning)
   OUT_DIR/window.png          the whole window of the first
   OUT_DIR/search.png          the window with F3 menu search for "radiosity"
+  OUT_DIR/sidebar.png         the 3D view with its sidebar (N) on the Radiosity tab
 Prints one line "RESULT <json>" (the Properties region's size, whether the
 result objects were selectable, whether UILayout.progress drew the bar, the
 files) before quitting.
@@ -35,7 +36,7 @@ def fail(err):
 
 
 addon_utils.enable("radiosity", default_set=False, handle_error=fail)
-from radiosity import operators, result_state  # noqa: E402  (the add-on, enabled above)
+from radiosity import operators, result_state, ui  # noqa: E402  (the add-on, enabled above)
 
 # The progress dict an interactive solve reports (operators.running_progress).
 FAKE_PROGRESS = {"fraction": 0.43, "pass": 2, "passes": 7, "leaves": 12316, "elements": 24631,
@@ -109,9 +110,44 @@ def solve():
         bpy.ops.radiosity.solve('EXEC_DEFAULT')
 
 
-def screenshot(name, whole=False):
+def view_area():
+    return next(a for a in window().screen.areas if a.type == 'VIEW_3D')
+
+
+def close_search():
+    win, view = window(), view_area()
+    x, y = view.x + view.width // 2, view.y + view.height // 2
+    win.event_simulate(type='ESC', value='PRESS', x=x, y=y)
+    win.event_simulate(type='ESC', value='RELEASE', x=x, y=y)
+
+
+def show_sidebar(attempt=0):
+    """The 3D view's sidebar (N) open, and a click on its tab strip at the right
+    edge, lower each attempt (Region.active_panel_category is not in 3.4), until
+    the Radiosity tab is the one drawn (count_sidebar_draws)."""
+    view = view_area()
+    view.spaces.active.show_region_ui = True
+    sidebar = region(view, 'UI')
+    x, y = sidebar.x + sidebar.width - 8, sidebar.y + sidebar.height - 40 - 30 * attempt
+    win = window()
+    win.event_simulate(type='MOUSEMOVE', value='NOTHING', x=x, y=y)
+    win.event_simulate(type='LEFTMOUSE', value='PRESS', x=x, y=y)
+    win.event_simulate(type='LEFTMOUSE', value='RELEASE', x=x, y=y)
+
+
+def count_sidebar_draws():
+    """Counts the draws of the sidebar's Radiosity panel (drawn only on its tab)."""
+    drawn = ui.VIEW3D_PT_radiosity.draw
+
+    def draw(panel, context):
+        state["sidebar_draws"] = state.get("sidebar_draws", 0) + 1
+        drawn(panel, context)
+    bpy.types.VIEW3D_PT_radiosity.draw = draw
+
+
+def screenshot(name, whole=False, area=None):
     path = os.path.join(OUT, name)
-    win, area = window(), properties_area()
+    win, area = window(), area or properties_area()
     if whole:
         with bpy.context.temp_override(window=win, screen=win.screen, area=area):
             bpy.ops.screen.screenshot(filepath=path)
@@ -167,6 +203,16 @@ def step():
             search("radiosity")
         elif n == 9:
             screenshot("search.png", whole=True)
+            close_search()
+        elif n == 10:
+            count_sidebar_draws()
+            view_area().spaces.active.show_region_ui = True
+        elif n < 22 and not state.get("sidebar_draws"):
+            show_sidebar(n - 11)
+        elif "sidebar_draws" in state and "sidebar" not in state:
+            state["sidebar"] = True
+            screenshot("sidebar.png", area=view_area())
+            state["result"]["sidebar_drawn"] = state["sidebar_draws"]
         else:
             finish()
             return None

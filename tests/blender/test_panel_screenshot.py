@@ -27,7 +27,7 @@ from test_solve import ADDON_DIR, build_file
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCREENSHOTS = os.path.join(os.path.dirname(ADDON_DIR), "screenshots")  # BUILD/screenshots
-FILES = ("panel.png", "panel_end.png", "panel_progress.png", "window.png", "search.png")
+FILES = ("panel.png", "panel_end.png", "panel_progress.png", "window.png", "search.png", "sidebar.png")
 
 
 @unittest.skipIf(shutil.which("xvfb-run") is None, "xvfb-run not installed (apt-get install xvfb libgl1-mesa-dri)")
@@ -60,6 +60,10 @@ class PanelScreenshotTest(unittest.TestCase):
             finally:
                 bpy.data.images.remove(image)
         print("[summary] panel screenshots in %s" % SCREENSHOTS)
+
+    def test_sidebar_has_a_radiosity_tab(self):
+        # Drawn in the window's sidebar once its tab was chosen (Ctrl+Wheel over it).
+        self.assertGreater(self.result.get("sidebar_drawn", 0), 0)
 
     def test_properties_width_is_the_one_labels_are_checked_at(self):
         self.assertEqual(self.result["region"][0], DEFAULT_REGION_WIDTH)
