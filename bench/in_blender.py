@@ -1,6 +1,7 @@
 """What the benchmarks that run inside Blender (contact_gap.py,
-tessellated_room.py) share: their options after `--`, and the add-on loaded
-from a build tree with the Cycles-agreement helpers of tests/blender."""
+tessellated_room.py, window_speed.py) share: their options after `--`, the
+add-on loaded from a build tree with the Cycles-agreement helpers of
+tests/blender, and their tables written to <build>/bench."""
 
 import argparse
 import pathlib
@@ -25,3 +26,12 @@ def load_addon(build):
     import radiosity
     radiosity.register()
     return radiosity
+
+
+def write_table(build, name, rows):
+    """Prints the markdown table of `rows` and writes it to <build>/bench/<name>.md."""
+    table = "\n".join(rows) + "\n"
+    print(table)
+    out = pathlib.Path(build).resolve() / "bench"
+    out.mkdir(parents=True, exist_ok=True)
+    (out / (name + ".md")).write_text(table)

@@ -51,11 +51,7 @@ def main():
                 print(rows[-1], "(%.0f s with the render)" % seconds, flush=True)
         if args.images:
             ca.save_pngs(args.images, label, reference, renders)
-    table = "\n".join(rows) + "\n"
-    print(table)
-    out = pathlib.Path(args.build).resolve() / "bench"
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "tessellated_room.md").write_text(table)
+    in_blender.write_table(args.build, "tessellated_room", rows)
 
 
 if __name__ == "__main__":

@@ -46,11 +46,7 @@ def main():
             "/".join(str(r["leaves_after"].get(str(m), "-")) for m in MARKS),
             "/".join(str(headless_after.get(m, "-")) for m in MARKS)))
         print(rows[-1], flush=True)
-    table = "\n".join(rows) + "\n"
-    print(table)
-    out = pathlib.Path(args.build).resolve() / "bench"
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "window_speed.md").write_text(table)
+    in_blender.write_table(args.build, "window_speed", rows)
 
 
 if __name__ == "__main__":

@@ -57,6 +57,21 @@ def emission_strength(material):
     return sum(node.inputs["Strength"].default_value for node in nodes if node.type == 'EMISSION')
 
 
+def render_pixels(scene):
+    """F12 of `scene` with its own settings, written as OpenEXR (linear values):
+    its pixels as (N, 4) RGBA."""
+    scene.render.image_settings.file_format = 'OPEN_EXR'
+    with tempfile.TemporaryDirectory() as tmp:
+        scene.render.filepath = os.path.join(tmp, scene.name + ".exr")
+        with bpy.context.temp_override(scene=scene):
+            bpy.ops.render.render(write_still=True, scene=scene.name)
+        image = bpy.data.images.load(scene.render.filepath)
+        pixels = np.empty(len(image.pixels), dtype=np.float32)
+        image.pixels.foreach_get(pixels)
+        bpy.data.images.remove(image)
+    return pixels.reshape(-1, 4)
+
+
 class SceneBuildersTest(unittest.TestCase):
     built = {}
 
@@ -90,17 +105,9 @@ class SceneBuildersTest(unittest.TestCase):
         build_scene.build("office", scene)
         self.assertEqual(scene.cycles.use_denoising, kit.cycles_denoiser_available())
         scene.cycles.samples, scene.render.resolution_percentage = 4, 10
-        with tempfile.TemporaryDirectory() as tmp:
-            scene.render.filepath = os.path.join(tmp, "office.exr")
-            scene.render.image_settings.file_format = 'OPEN_EXR'
-            with bpy.context.temp_override(scene=scene):
-                bpy.ops.render.render(write_still=True, scene=scene.name)
-            image = bpy.data.images.load(scene.render.filepath)
-            pixels = np.empty(len(image.pixels), dtype=np.float32)
-            image.pixels.foreach_get(pixels)
-            bpy.data.images.remove(image)
+        pixels = render_pixels(scene)
         bpy.data.scenes.remove(scene)
-        self.assertGreater(float(np.median(pixels.reshape(-1, 4)[:, :3])), 0.02)
+        self.assertGreater(float(np.median(pixels[:, :3])), 0.02)
 
     def test_quads_only(self):
         # But for the Cornell box's left wall: its published quad is not planar,
@@ -194,16 +201,7 @@ class SceneBuildersTest(unittest.TestCase):
             scene.render.resolution_percentage = 12
             scene.cycles.samples = 8
             scene.cycles.use_denoising = False
-            scene.render.image_settings.file_format = 'OPEN_EXR'  # linear values
-            with tempfile.TemporaryDirectory() as tmp:
-                scene.render.filepath = os.path.join(tmp, name + ".exr")
-                with bpy.context.temp_override(scene=scene):
-                    bpy.ops.render.render(write_still=True, scene=scene.name)
-                image = bpy.data.images.load(scene.render.filepath)
-                pixels = np.empty(len(image.pixels), dtype=np.float32)
-                image.pixels.foreach_get(pixels)
-                bpy.data.images.remove(image)
-            luminance = pixels.reshape(-1, 4)[:, :3] @ np.array([0.2126, 0.7152, 0.0722])
+            luminance = render_pixels(scene)[:, :3] @ np.array([0.2126, 0.7152, 0.0722])
             if name in catalog.ROOMS:
                 self.assertTrue(0.05 < np.median(luminance) < 0.6, np.median(luminance))
             else:  # an open set-up against a black world: judge the lit part
