@@ -11,7 +11,8 @@ checked here and run for real under Wine (tools/wine.py).
   import brought in; then the native module's Python tests (tests/native, but for
   the three that check Linux things: the C++ formatting, the study's Linux-only
   `_image_metric`, the Linux zip) in that Python with that module, each file in a
-  process of its own. numpy 2 (the only numpy for 3.13) calls ucrtbase's crealf,
+  process of its own; the files of the solver's numerics (run_tests.py's
+  NATIVE_ONCE) in 3.11 only, as the extra Linux Pythons do. numpy 2 (the only numpy for 3.13) calls ucrtbase's crealf,
   which Wine 8 lacks: where numpy does not import under this Wine, the 3.13 suite
   is skipped, saying so, and only the import runs.
 - PyPI's Blender 4.5 LTS for Windows (bpy 4.5.15, win_amd64) under Wine installs the
@@ -38,9 +39,15 @@ import wine  # tools/wine.py (on sys.path through packages)
 sys.path.insert(0, str(ROOT / "tests" / "blender"))
 from solved_report import check_solved_and_baked  # noqa: E402  (what test_package.py checks too)
 
+sys.path.insert(0, str(ROOT / "tests"))
+import run_tests  # noqa: E402  (its NATIVE_ONCE)
+
 NATIVE = ROOT / "tests" / "native"
 HERE = Path(__file__).resolve().parent
 NOT_UNDER_WINE = {"test_format.py", "test_image_metric.py", "test_package.py"}
+# The files that test the solver's numerics run in one Windows Python (the core is the
+# same static library in each module), as tests/run_tests.py's NATIVE_ONCE in Linux.
+NUMERICS_IN = "3.11"
 SYSTEM_DLLS = re.compile(r"^(KERNEL32\.dll|api-ms-win-crt-[a-z]+-l1-1-0\.dll)$", re.IGNORECASE)
 TIMEOUT = 900
 
@@ -127,8 +134,9 @@ class WineTest(UnpackedZip):
                     ", ".join(p.split("\\")[-1] for p in report["new"])), flush=True)
 
     def test_native_suite_under_wine(self):
-        files = sorted(p for p in NATIVE.glob("test_*.py") if p.name not in NOT_UNDER_WINE)
+        every = sorted(p for p in NATIVE.glob("test_*.py") if p.name not in NOT_UNDER_WINE)
         for minor in cpython.VERSIONS:
+            files = every if minor == NUMERICS_IN else [p for p in every if p.name not in run_tests.NATIVE_ONCE]
             with self.subTest(python=minor):
                 ok, output = self.numpy_imports(minor)
                 if not ok:
