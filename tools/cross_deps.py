@@ -16,6 +16,7 @@ The Linux build's recipe (tools/portable_deps.py) for other targets of the same 
 """
 
 import argparse
+import shutil
 import sys
 import time
 from pathlib import Path
@@ -126,7 +127,10 @@ def toolchain(build, platform):
         # No SDK here: zig brings the headers and libSystem's stubs; the target's
         # version (11.0) is the minimum macOS.
         lines += ["set(CMAKE_OSX_SYSROOT \"\")", "set(CMAKE_OSX_DEPLOYMENT_TARGET \"\")",
-                  "set(CMAKE_OSX_ARCHITECTURES \"\")"]
+                  "set(CMAKE_OSX_ARCHITECTURES \"\")",
+                  # CMake wants Apple's install_name_tool for projects with C (GoogleTest's):
+                  # nothing here is installed, so nothing needs a new install name.
+                  "set(CMAKE_INSTALL_NAME_TOOL %s)" % shutil.which("true")]
     (folder / "zig.cmake").write_text("\n".join(lines) + "\n")
 
 
