@@ -141,9 +141,15 @@ def main():
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     parser.add_argument("--if-deps", action="store_true",
                         help="only the platforms whose Embree and oneTBB are built (make package)")
-    parser.add_argument("platforms", nargs="*", choices=PLATFORMS, default=PLATFORMS)
+    # Checked here, not with `choices`: Debian's Python 3.11 checks an empty
+    # list of them as one value and refuses it (`make package` failed on a
+    # fresh clone).
+    parser.add_argument("platforms", nargs="*", help="of %s; all when none is named" % ", ".join(PLATFORMS))
     args = parser.parse_args()
-    for platform in args.platforms:
+    unknown = sorted(set(args.platforms) - set(PLATFORMS))
+    if unknown:
+        parser.error("unknown platform %s (choose from %s)" % (", ".join(unknown), ", ".join(PLATFORMS)))
+    for platform in args.platforms or PLATFORMS:
         folder = cross_deps.folder_of(args.build, platform)
         if args.if_deps and not ((folder / "onetbb.done").exists() and (folder / "embree.done").exists()):
             continue
