@@ -44,6 +44,18 @@ EMBREE_WINDOWS_FIXES = {
                              "  static bool win_enable_selockmemoryprivilege_unused (bool verbose)\n  {\n"
                              "    HANDLE hToken;"),
 }
+# Embree marks its task scheduler's functions visibility("default") on every system
+# but Windows, static library or not; zig's Mach-O linker takes no export list, so
+# the macOS modules would export them: like its Windows static build, none.
+EMBREE_STATIC_VISIBILITY_FIXES = {
+    "common/sys/platform.h": ('#else\n#  define dll_export __attribute__ ((visibility ("default")))\n',
+                              '#elif defined(EMBREE_STATIC_LIB)   // tools/cross_deps.py: nothing exported\n'
+                              '#  define dll_export\n#  define dll_import\n'
+                              '#else\n#  define dll_export __attribute__ ((visibility ("default")))\n'),
+}
+# macOS: oneTBB compiled with hidden symbols (it hides them with an export list,
+# which a static library never gets), for the same reason.
+DARWIN_TBB = ["-DCMAKE_CXX_VISIBILITY_PRESET=hidden", "-DCMAKE_VISIBILITY_INLINES_HIDDEN=ON"]
 # oneTBB marks its functions __declspec(dllexport) under MinGW, also in a static
 # library, which would export them from the module: its export header is
 # pre-empted (guard and macros defined empty) for the Windows build.
@@ -142,9 +154,11 @@ def embree_options(platform):
     options = list(portable_deps.EMBREE_OPTIONS)
     if PLATFORMS[platform]["processor"] == "arm64":
         options = [o for o in options if not o.startswith("-DEMBREE_ISA_")] + ARM_ISA
+    # The fixes' files named in the options: a build without them is not reused.
     if PLATFORMS[platform]["system"] == "Windows":
-        # The fixes' files named in the options: a build without them is not reused.
         options += WINDOWS_EMBREE + ["-DRADIOSITY_CROSS_FIXES=%s" % ",".join(sorted(EMBREE_WINDOWS_FIXES))]
+    else:
+        options += ["-DRADIOSITY_CROSS_FIXES=%s" % ",".join(sorted(EMBREE_STATIC_VISIBILITY_FIXES))]
     return options
 
 
@@ -154,6 +168,8 @@ def tbb_options(folder, platform):
         header = folder / "tbb_static_exports.h"
         header.write_text(TBB_STATIC_EXPORTS)
         options.append("-DCMAKE_CXX_FLAGS=-include %s" % header)
+    else:
+        options += DARWIN_TBB
     return options
 
 
@@ -180,6 +196,8 @@ def build(build_dir, platform):
     start = time.perf_counter()
     if PLATFORMS[platform]["system"] == "Windows":
         fix_sources(src["embree"], EMBREE_WINDOWS_FIXES)
+    else:
+        fix_sources(src["embree"], EMBREE_STATIC_VISIBILITY_FIXES)
     portable_deps.build_static(folder, "onetbb", src["onetbb"], tbb_options(folder, platform))
     portable_deps.build_static(folder, "embree", src["embree"], embree_options(platform))
     log("%s: Embree and oneTBB ready in %s (%.0f s)" % (platform, folder, time.perf_counter() - start))
