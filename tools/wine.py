@@ -34,7 +34,7 @@ CLASSIFIER = "windows-x86_64"
 # numpy 2 calls ucrtbase's crealf, which Wine 8 does not have, so under Wine 8 the
 # 3.13 module runs only what needs no numpy (tests/native/test_windows.py says so).
 SITES = {
-    "3.10": ("3.10", ["numpy==1.26.4"]),
+    "3.10": ("3.10", ["numpy==1.26.4", "tomli==2.0.1"]),   # tomli: 3.11's tomllib, for test_module
     "3.11": ("3.11", ["numpy==1.26.4"]),
     "3.13": ("3.13", ["numpy==2.5.5"]),
     # PyPI's Blender 4.5 LTS for Windows; imports and runs under Wine 8 with numpy 1.26.4.
