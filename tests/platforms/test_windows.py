@@ -111,7 +111,7 @@ class WineTest(UnpackedZip):
             raise AssertionError(str(err))
 
     def python(self, minor, args, **kwargs):
-        return wine.run(BUILD, minor, args, capture_output=True, text=True, timeout=TIMEOUT,
+        return wine.run(BUILD, minor, args, capture_output=True, text=True, errors="replace", timeout=TIMEOUT,
                         stdin=subprocess.DEVNULL, cwd=self.root, **kwargs)
 
     def numpy_imports(self, minor):
@@ -210,7 +210,7 @@ class WineBlenderTest(unittest.TestCase):
     and its render of the solution agrees with Cycles' path trace as test_cycles.py requires."""
 
     def bpy(self, args, cwd, env=None):
-        proc = wine.run(BUILD, "bpy-4.5", args, env=env or {}, capture_output=True, text=True, timeout=TIMEOUT,
+        proc = wine.run(BUILD, "bpy-4.5", args, env=env or {}, capture_output=True, text=True, errors="replace", timeout=TIMEOUT,
                         stdin=subprocess.DEVNULL, cwd=cwd)
         log = proc.stdout[-3000:] + proc.stderr[-3000:]
         lines = [line for line in proc.stdout.splitlines() if line.startswith("RESULT ")]
