@@ -340,7 +340,7 @@ def export_scene(context, blender_version=None):
                     lights_not_modelled[kind] = lights_not_modelled.get(kind, 0) + 1
                 elif np.any(solver_light.get("intensity", solver_light.get("irradiance")) > 0):
                     direct_lights.append(solver_light)
-                if light.use_nodes:
+                if light_nodes_change_it(light):
                     light_notes.add("light node setups")
                 continue
             local, area = arrays.area_light_polygon(light.shape, light.size, light.size_y)
@@ -351,7 +351,7 @@ def export_scene(context, blender_version=None):
                                                   compat.light_exposure(light), compat.light_normalized(light))
             if getattr(light, "spread", math.pi) < math.pi - 1e-6:
                 light_notes.add("area light spread")
-            if light.use_nodes:
+            if light_nodes_change_it(light):
                 light_notes.add("light node setups")
             points = arrays.transform_points(local, matrix)
             n = len(points)
@@ -450,6 +450,21 @@ def _keep_uv_faces(part, keep, corner_keep):
     kept = keep[part.triangle_face]
     part.triangles = corner_map[part.triangles[kept]]
     part.triangle_face = face_map[part.triangle_face[kept]]
+
+
+def light_nodes_change_it(light):
+    """Whether a light's node tree changes its light (not modelled): anything but
+    the tree Blender 5.x gives every new light, a white Emission of strength 1
+    into the Light Output, which renders as no nodes at all."""
+    if not light.use_nodes or light.node_tree is None:
+        return False
+    nodes = light.node_tree.nodes
+    if sorted(n.bl_idname for n in nodes) != ['ShaderNodeEmission', 'ShaderNodeOutputLight']:
+        return True
+    emission = next(n for n in nodes if n.bl_idname == 'ShaderNodeEmission')
+    colour, strength = emission.inputs["Color"], emission.inputs["Strength"]
+    return (colour.is_linked or strength.is_linked or abs(strength.default_value - 1.0) > 1e-6
+            or any(abs(c - 1.0) > 1e-6 for c in tuple(colour.default_value)[:3]))
 
 
 def _direct_light(light, matrix, version):

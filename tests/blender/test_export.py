@@ -223,7 +223,15 @@ class LightTest(unittest.TestCase):
             scene.collection.objects.link(obj)
         for kind in ('POINT', 'SPOT', 'SUN', 'POINT'):
             scene.collection.objects.link(bpy.data.objects.new(kind, bpy.data.lights.new(kind, kind)))
-        bpy.data.lights["POINT"].use_nodes = True   # light node setups (IES too) are not modelled
+        # Light node setups (IES too) are not modelled; the tree Blender 5.x gives
+        # every new light (a white Emission of strength 1) changes nothing.
+        default_tree = bpy.data.lights["POINT"]
+        default_tree.use_nodes = True
+        self.assertFalse(export.light_nodes_change_it(default_tree))
+        self.assertEqual(export.unmodelled_message(export_now().unmodelled), "")
+        emission = next(n for n in default_tree.node_tree.nodes if n.bl_idname == 'ShaderNodeEmission')
+        emission.inputs["Strength"].default_value = 2.0
+        self.assertTrue(export.light_nodes_change_it(default_tree))
         ex = export_now()
         self.assertEqual(sorted(p.name for p in ex.parts), ["Disk", "Ellipse", "Rect"])
         a = ex.arrays
