@@ -216,10 +216,7 @@ def restore_views(scene):
         if key in saved:
             shading = space.shading
             shading.color_type, shading.light, shading.show_backface_culling = saved[key]
-    scene.pop(VIEWS_TAG, None)
-    wm = _window_manager()
-    if wm is not None:
-        wm.pop(VIEWS_TAG, None)
+    put_views_record(scene, (None, None))
 
 
 def result_shown(scene):
