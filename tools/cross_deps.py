@@ -54,8 +54,12 @@ EMBREE_STATIC_VISIBILITY_FIXES = {
                               '#else\n#  define dll_export __attribute__ ((visibility ("default")))\n'),
 }
 # macOS: oneTBB compiled with hidden symbols (it hides them with an export list,
-# which a static library never gets), for the same reason.
-DARWIN_TBB = ["-DCMAKE_CXX_VISIBILITY_PRESET=hidden", "-DCMAKE_VISIBILITY_INLINES_HIDDEN=ON"]
+# which a static library never gets), for the same reason. Its CMakeLists asks for
+# CMake 3.1, whose policies apply a visibility preset to shared libraries only
+# (CMP0063): without the policy set the archive's functions stayed visible and the
+# first arm64 modules exported 227 of oneTBB's (llvm-nm-16).
+DARWIN_TBB = ["-DCMAKE_CXX_VISIBILITY_PRESET=hidden", "-DCMAKE_VISIBILITY_INLINES_HIDDEN=ON",
+              "-DCMAKE_POLICY_DEFAULT_CMP0063=NEW"]
 # oneTBB marks its functions __declspec(dllexport) under MinGW, also in a static
 # library, which would export them from the module: its export header is
 # pre-empted (guard and macros defined empty) for the Windows build.

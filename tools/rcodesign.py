@@ -50,7 +50,10 @@ def install(build):
     log.parent.mkdir(parents=True, exist_ok=True)
     with open(log, "w") as out:
         proc = subprocess.run([cargo(), "install", "%s@%s" % (CRATE, VERSION), "--locked", "--no-default-features",
-                               "--root", str(folder(build)), "--force", "-j", str(os.cpu_count() or 1)],
+                               "--root", str(folder(build)), "--force", "-j", str(os.cpu_count() or 1),
+                               # its own target folder, kept: a build cut short resumes
+                               # where it stopped (cargo install's temporary one is deleted)
+                               "--target-dir", str(folder(build).parent / "rcodesign-target")],
                               stdout=out, stderr=subprocess.STDOUT)
     if proc.returncode != 0:
         sys.exit("error: cargo install %s failed; see %s:\n%s" % (CRATE, log, log.read_text()[-3000:]))
