@@ -58,6 +58,7 @@ def install(build):
     if proc.returncode != 0:
         sys.exit("error: cargo install %s failed; see %s:\n%s" % (CRATE, log, log.read_text()[-3000:]))
     stamp.write_text(VERSION)
+    shutil.rmtree(folder(build).parent / "rcodesign-target", ignore_errors=True)   # 640 MB, of no more use
     print("[rcodesign] built in %.0f s" % (time.perf_counter() - start), flush=True)
     return executable(build)
 

