@@ -72,8 +72,9 @@ NATIVE_ONCE = {
 # The package-level check of a --check-blender Blender.
 PACKAGE_CHECK = {"test_package.py"}
 # Seconds the tests/platforms files may take (test_windows.py runs tests/native under
-# Wine in three Windows CPythons and Windows Blender 4.5 four times).
-PLATFORMS_TIMEOUT = 3600
+# Wine in three Windows CPythons, 3.11's with the numerics files, and Windows Blender
+# 4.5 four times: about 50 minutes on two shared cores, README "Other platforms").
+PLATFORMS_TIMEOUT = 7200
 LOG_TAIL = 80  # lines of a crashed process' output worth showing
 
 

@@ -11,6 +11,11 @@ endif()
 set(gtest_force_shared_crt ON CACHE BOOL "" FORCE)
 set(gtest_disable_pthreads ON CACHE BOOL "" FORCE)   # its own threads are not needed: no death tests
 add_subdirectory(${RADIOSITY_GTEST_SOURCE} ${CMAKE_BINARY_DIR}/googletest EXCLUDE_FROM_ALL)
+# GoogleTest 1.12's gtest-internal.h uses FLT_MAX and DBL_MAX without <cfloat>, which
+# the macOS libc++ headers do not bring in through others (the macOS builds failed).
+if(CMAKE_SYSTEM_NAME STREQUAL "Darwin")
+  target_compile_options(gtest PUBLIC -include cfloat)   # and whatever includes gtest.h
+endif()
 file(GLOB TEST_SOURCES CONFIGURE_DEPENDS ${NATIVE}/core/*/*_test.cpp)
 add_executable(radiosity_tests ${TEST_SOURCES})
 target_include_directories(radiosity_tests PRIVATE ${NATIVE})

@@ -1,6 +1,7 @@
 """The macOS zips (arm64 and x86-64; `make test-platforms`: tools/cross_build.py's
 modules, tools/package.py). macOS cannot run here: each module is checked as a
-Mach-O file with LLVM's tools (llvm-objdump-16, llvm-nm-16) and rcodesign.
+Mach-O file with LLVM's tools (llvm-objdump-16, llvm-nm-16) and its signature by
+code_signature.py.
 
 - the architecture of its zip (arm64 or x86_64), a dylib (zig's linker makes no
   bundles; Python loads either), not marked NOUNDEFS (its Python symbols are
@@ -14,8 +15,9 @@ Mach-O file with LLVM's tools (llvm-objdump-16, llvm-nm-16) and rcodesign.
   names) or a Python C-API symbol (Py*, _Py*) looked up in the process that loads it
   (-undefined dynamic_lookup, flat lookup: Blender's Python provides them);
 - the libraries it loads: /usr/lib/libSystem.B.dylib and /usr/lib/libc++.1.dylib at most;
-- an ad hoc code signature that `rcodesign verify` accepts (arm64 Macs run no
-  unsigned code);
+- an ad hoc code signature (rcodesign's) whose CodeDirectory hashes every page
+  of the file before it, checked as the kernel checks it (code_signature.py;
+  arm64 Macs run no unsigned code);
 - and the solver's C++ unit tests, cross-built for each Mac, link.
 """
 
@@ -25,7 +27,7 @@ import unittest
 
 from packages import BUILD, PackageChecks, UnpackedZip, cross_build
 
-import rcodesign  # tools/rcodesign.py (on sys.path through packages)
+import code_signature  # tests/platforms/code_signature.py
 
 ALLOWED_DYLIBS = {"/usr/lib/libSystem.B.dylib", "/usr/lib/libc++.1.dylib"}
 ALLOWED_SOURCES = {"libSystem", "libc++"}
@@ -106,8 +108,7 @@ class MacPackageChecks(PackageChecks):
         for minor, path in self.modules.items():
             with self.subTest(python=minor):
                 self.assertIn("LC_CODE_SIGNATURE", load_commands(path))
-                ok, output = rcodesign.verify(BUILD, path)
-                self.assertTrue(ok, output)
+                self.assertEqual(code_signature.check(path), [])
 
 
 class MacUnitTests(unittest.TestCase):
