@@ -11,10 +11,12 @@ endif()
 set(gtest_force_shared_crt ON CACHE BOOL "" FORCE)
 set(gtest_disable_pthreads ON CACHE BOOL "" FORCE)   # its own threads are not needed: no death tests
 add_subdirectory(${RADIOSITY_GTEST_SOURCE} ${CMAKE_BINARY_DIR}/googletest EXCLUDE_FROM_ALL)
-# GoogleTest 1.12's gtest-internal.h uses FLT_MAX and DBL_MAX without <cfloat>, which
-# the macOS libc++ headers do not bring in through others (the macOS builds failed).
+# GoogleTest 1.12's gtest-internal.h uses FLT_MAX and DBL_MAX, which zig's macOS
+# headers leave undefined there (the macOS unit tests did not compile; including
+# <cfloat> first instead left INFINITY undefined in libc++'s <random>): defined as
+# the compiler's own values, as <float.h> defines them, for whatever includes gtest.h.
 if(CMAKE_SYSTEM_NAME STREQUAL "Darwin")
-  target_compile_options(gtest PUBLIC -include cfloat)   # and whatever includes gtest.h
+  target_compile_definitions(gtest PUBLIC FLT_MAX=__FLT_MAX__ DBL_MAX=__DBL_MAX__)
 endif()
 file(GLOB TEST_SOURCES CONFIGURE_DEPENDS ${NATIVE}/core/*/*_test.cpp)
 add_executable(radiosity_tests ${TEST_SOURCES})
