@@ -124,7 +124,8 @@ class MacUnitTests(unittest.TestCase):
                 header = tool("llvm-objdump", "--macho", "--private-header", str(path))
                 self.assertRegex(header, r"MH_MAGIC_64\s+%s\s.*\sEXECUTE\s" % arch)
                 commands = load_commands(path)
-                self.assertRegex(commands, r"cmd LC_BUILD_VERSION.*?minos %s" % re.escape(MIN_MACOS))
+                self.assertRegex(commands, re.compile(r"cmd LC_BUILD_VERSION.*?minos %s\s" % re.escape(MIN_MACOS),
+                                                      re.DOTALL))
                 dylibs = re.findall(r"cmd LC_LOAD_DYLIB\s+cmdsize \d+\s+name (\S+)", commands)
                 self.assertEqual(dylibs, ["/usr/lib/libSystem.B.dylib"])
                 print("[macos] %s's unit tests link: %s (%.1f MB)" % (platform, path.name, path.stat().st_size / 1e6),
