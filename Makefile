@@ -83,7 +83,7 @@ package: build
 	@$(PYTHON) tools/package.py --build $(BUILD)
 
 # The Windows and macOS zips and their tests, outside `make test` (fresh, about 20
-# minutes per platform on two cores, README "Other platforms"): Wine and LLVM's tools
+# minutes per platform on two cores, README "Windows and macOS"): Wine and LLVM's tools
 # from Debian; per platform zig's runtime, Embree and oneTBB (once, into $(BUILD)/cross),
 # its modules for each CPython (tools/cross_build.py; macOS ones signed with rcodesign,
 # built once with cargo), the zips, then tests/platforms: each module's imports, exports

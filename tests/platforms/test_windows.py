@@ -15,7 +15,9 @@ checked here and run for real under Wine (tools/wine.py).
   process of its own; the files of the solver's numerics (run_tests.py's
   NATIVE_ONCE) in 3.11 only, as the extra Linux Pythons do. numpy 2 (the only
   numpy for 3.13) calls ucrtbase's crealf and cimagf, which Wine 8 has only as
-  stubs: tools/wine_site/sitecustomize.py supplies them, so 3.13's suite runs too.
+  stubs, and Python 3.13's `platform` asks WMI through propsys's VariantToString,
+  another: tools/wine_site/sitecustomize.py supplies the first and turns WMI off,
+  so 3.13's suite runs too.
 - PyPI's Blender 4.5 LTS for Windows (bpy 4.5.15, win_amd64) under Wine installs the
   extension zip and the legacy zip into an empty user folder, enables the add-on,
   solves the bundled cube scene, bakes it and renders it beside a Cycles path trace

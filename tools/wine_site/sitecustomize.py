@@ -6,7 +6,12 @@ still Wine's stub (its code loads the string of its own name, for the message) i
 overwritten here, in this process only, with the one to three instructions it is in
 the Windows x64 ABI; Wine's own implementations (creal) and a Wine that has them all
 are left alone. Checked with numpy 2.5.5 under Wine 8.0: complex64 and complex128
-real, imag, abs, conj and angle as on Linux."""
+real, imag, abs, conj and angle as on Linux.
+
+Also: Python 3.12 and later ask WMI for the platform (`platform.uname()`, which
+numpy.testing calls), through propsys's VariantToString, another of Wine 8's
+aborting stubs; without `_wmi` they fall back to the version Windows reports, as
+`platform` does where WMI is not there."""
 import ctypes
 import sys
 
@@ -55,3 +60,4 @@ def _patch():
 
 if sys.platform == "win32":
     PATCHED = _patch()
+    sys.modules["_wmi"] = None   # `import _wmi` fails: platform's own fallback
