@@ -105,6 +105,26 @@ def visibility_hint(visibility, stats):
             "link faster still" % (stats["seconds_linking"], links))
 
 
+# Why a solve stopped before its first pass, in the words of rough_look_hint.
+STOPPED_WHILE_LINKING = {
+    "time_budget": "the Time Limit ran out",
+    "memory": "the memory limit was reached",
+    "cancel": "it was cancelled",
+}
+
+
+def rough_look_hint(stats):
+    """What the result is when the solve stopped while it was linking (before
+    its first pass): the ray pass's rough look (native/core/solve/ray_pass.h),
+    right in brightness but blotchy, and what to change."""
+    why = STOPPED_WHILE_LINKING.get(stats.get("stopped_by"))
+    if not why or stats.get("passes", 0) or not stats.get("ray_pass_rays"):
+        return ""
+    return ("Rough look only: %s while linking (%.0f s), so the result is the quick first look traced by rays: "
+            "right in brightness, blotchy in detail. For the solved result raise the Time Limit, or lower "
+            "Quality, or use Visibility 'Sampled'" % (why, stats.get("seconds_linking", 0.0)))
+
+
 def prepare(context, solver, started=None):
     """Export the scene and make the native Scene (main thread); the Solve
     began at `started` (time.perf_counter; None: now)."""
@@ -285,9 +305,9 @@ def record(context, job, stats, skipped_objects, warnings):
     note = export.unmodelled_message(job.exported.unmodelled)
     if note:
         warnings.append(note)
-    hint = visibility_hint(job.options.get("visibility"), stats)
-    if hint:
-        warnings.append(hint)
+    for hint in (rough_look_hint(stats), visibility_hint(job.options.get("visibility"), stats)):
+        if hint:
+            warnings.append(hint)
     coincident = export.coincident_message(job.exported, job.native_scene.coincident_faces)
     if coincident:
         warnings.append(coincident)

@@ -19,6 +19,7 @@
 #include "core/solve/gather.h"
 #include "core/solve/link_batch.h"
 #include "core/solve/pass_progress.h"
+#include "core/solve/ray_pass.h"
 #include "core/solve/refine.h"
 #include "core/solve/reuse.h"
 #include "core/solve/system_memory.h"
@@ -137,7 +138,11 @@ class Solver {
   bool refine_cluster_links();
   void mark_cluster_receivers_linked();
   void count(SolveStats& stats) const;
+  void look_by_rays();
   void link_initially();
+  // Linking cannot finish: cancelled, out of time, or the walk's memory (the
+  // process's growth since the solve began) past the memory limit.
+  bool linking_stopped() const;
   void drop_links_light_cannot_reach();
   std::vector<Link> evaluate(std::vector<Link>&& candidates);
   bool refine(double threshold);
@@ -186,7 +191,8 @@ class Solver {
   std::uint64_t links_version_ = 1, grouped_version_ = 0;
   SolveResult result_;       // the last complete pass
   bool budget_hit_ = false;  // max_elements or memory_limit reached
-  bool memory_hit_ = false;
+  mutable std::atomic<bool> memory_hit_{
+      false};                          // also set by linking_stopped() from the walk's threads
   bool cut_short_ = false;             // the last evaluate_links stopped before the end
   bool refinement_cut_short_ = false;  // ... within refine(): the pass is abandoned
   std::vector<double> qualities_;      // one per pass (pass_qualities)
@@ -195,6 +201,7 @@ class Solver {
   PassProgress pass_progress_;
   double threshold_ = std::numeric_limits<double>::infinity();
   bool complete_ = false;
+  std::size_t resident_at_start_ = 0;  // peak resident bytes when the run began
   SolveStats stats_;
 };
 
@@ -253,6 +260,42 @@ std::vector<Link> Solver::evaluate(std::vector<Link>&& candidates) {
   return made;
 }
 
+// The ray pass (ray_pass.h): the result kept while linking runs, so that a
+// solve stopped there (by its budgets or Esc) returns the scene lit, coarsely,
+// not black. Nothing here changes what the passes compute: the elements' link
+// flags are set for the output mesh only and cleared again.
+void Solver::look_by_rays() {
+  const auto start = Clock::now();
+  const RayPass pass =
+      ray_pass(hierarchy_, *occluders_.rays, [this] { return cancelled() || out_of_time(); });
+  stats_.ray_pass_rays = pass.complete ? pass.rays : 0;
+  if (pass.complete) {
+    std::vector<SampleRgb> leaf(hierarchy_.elements().size());
+    std::vector<Element>& elements = hierarchy_.elements();
+    for (size_t e = 0; e < pass.gathered.size(); ++e) {
+      leaf[e].fill(pass.gathered[e]);
+      elements[e].has_links = luminance(pass.gathered[e]) > 0.0 ? 1 : 0;
+    }
+    result_.mesh = make_output_mesh(hierarchy_, leaf);
+    for (size_t e = 0; e < pass.gathered.size(); ++e) elements[e].has_links = 0;
+    count(stats_);
+    SolveStats shown = stats_;
+    shown.iterations = pass.iterations;
+    result_.stats = shown;
+  }
+  stats_.seconds_ray_pass = seconds_since(start);
+  if (pass.complete) report(SolvePhase::Linking, 0.0, &result_);  // shown while linking runs
+}
+
+bool Solver::linking_stopped() const {
+  if (cancelled() || out_of_time()) return true;
+  if (!memory_hit_ && options_.memory_limit &&
+      peak_resident_bytes() > resident_at_start_ + *options_.memory_limit) {
+    memory_hit_ = true;
+  }
+  return memory_hit_;
+}
+
 // Links between the top-level patch sides that can exchange light (the
 // receiver reflects, the emitter emits or reflects): clusters far apart that
 // face each other get one cluster link, pairs facing away are dropped whole,
@@ -268,14 +311,13 @@ void Solver::link_initially() {
   InitialLinks initial = link_clusters(
       clusters_, hierarchy_, *occluders_.rays,
       cluster_criterion(qualities_.front(), guess, scene_.reference_radiance()),
-      [this] { return cancelled() || out_of_time(); },
+      [this] { return linking_stopped(); },
       [this](double done) { report(SolvePhase::Linking, 0.05 * done); });
   stats_.seconds_clustering = seconds_since(start);
   // In blocks, so cancellation and progress stay prompt for large scenes.
   const size_t block = 65536;
   std::vector<Link>& candidates = initial.elements;
-  for (size_t begin = 0; begin < candidates.size() && !cancelled() && !out_of_time();
-       begin += block) {
+  for (size_t begin = 0; begin < candidates.size() && !linking_stopped(); begin += block) {
     const size_t end = std::min(candidates.size(), begin + block);
     std::vector<Link> visible =
         evaluate(std::vector<Link>(candidates.begin() + static_cast<std::ptrdiff_t>(begin),
@@ -616,11 +658,20 @@ void Solver::begin(const SolveOptions& options, const ProgressCallback& progress
 
 SolveResult Solver::run(const ProgressCallback& progress, const CancelCheck& cancel) {
   begin(options_, progress, cancel);
+  resident_at_start_ = peak_resident_bytes();
   qualities_ = pass_qualities();
   passes_ = static_cast<int>(qualities_.size());
   report(SolvePhase::Linking, 0.0);
+  look_by_rays();
   link_initially();
-  if (!cancelled()) snapshot(std::numeric_limits<double>::infinity());  // emitters only
+  if (linking_stopped()) {
+    if (memory_hit_)
+      stats_.stopped_by = StopReason::Memory;
+    else if (out_of_time() || cut_short_)
+      stats_.stopped_by = StopReason::TimeBudget;
+    return end();  // with the ray pass's light, if it finished
+  }
+  snapshot(std::numeric_limits<double>::infinity());  // emitters only
   solve_passes(kUnknownDrift);
   return end();
 }

@@ -139,6 +139,38 @@ bool RayScene::occluded(const dvec3& from, const dvec3& to, std::uint32_t skip_a
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
 }
 
+std::uint32_t RayScene::first_hit(const dvec3& from, const dvec3& to, std::uint32_t skip,
+                                  float& along) const {
+  along = 1.0f;
+  if (face_.empty() || from == to) return kNoFace;
+  FilterContext context;
+  rtcInitIntersectContext(&context.embree);
+  context.embree.filter = skip_own_faces;
+  context.face = face_.data();
+  context.skip_a = skip;
+  const float margin = end_margin(from, to);
+  RTCRayHit query;
+  RTCRay& ray = query.ray;
+  ray.org_x = static_cast<float>(from.x);
+  ray.org_y = static_cast<float>(from.y);
+  ray.org_z = static_cast<float>(from.z);
+  ray.dir_x = static_cast<float>(to.x - from.x);
+  ray.dir_y = static_cast<float>(to.y - from.y);
+  ray.dir_z = static_cast<float>(to.z - from.z);
+  ray.tnear = margin;
+  ray.tfar = 1.0f - margin;
+  ray.time = 0.0f;
+  ray.mask = 0xFFFFFFFFu;
+  ray.id = 0;
+  ray.flags = 0;
+  query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  query.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(scene_, &context.embree, &query);
+  if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) return kNoFace;
+  along = ray.tfar;
+  return face_[query.hit.primID];
+}
+
 void RayScene::occluded(const dvec3& from, std::span<const dvec3> to,
                         std::span<std::uint8_t> blocked, std::uint32_t skip_a,
                         std::uint32_t skip_b) const {

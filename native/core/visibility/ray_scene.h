@@ -39,6 +39,12 @@ class RayScene {
   void occluded(const dvec3& from, std::span<const dvec3> to, std::span<std::uint8_t> blocked,
                 std::uint32_t skip_a = kNoFace, std::uint32_t skip_b = kNoFace) const;
 
+  // The face of the nearest triangle on the segment from `from` to `to`, other
+  // than those of face `skip`, and where along it (0 to 1); kNoFace if none.
+  // (rtcIntersect1: the ray pass follows light to the surface it comes from.)
+  std::uint32_t first_hit(const dvec3& from, const dvec3& to, std::uint32_t skip,
+                          float& along) const;
+
   std::size_t size() const { return face_.size(); }
 
  private:

@@ -178,6 +178,8 @@ struct SolveStats {
   double seconds = 0.0;
   double seconds_linking = 0.0;
   double seconds_clustering = 0.0;  // of linking: the walk over cluster pairs, with its rays
+  double seconds_ray_pass = 0.0;    // the rough look before linking (ray_pass.h)
+  int ray_pass_rays = 0;            // its rays per reflecting top-level element
   LinkTimings link_cpu;             // CPU seconds over all threads
   double seconds_gather = 0.0;      // gather and push/pull, wall clock
   std::size_t element_bytes = 0;
