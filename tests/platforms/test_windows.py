@@ -232,7 +232,7 @@ class WineBlenderTest(unittest.TestCase):
             self.assertTrue(inside(report["module_file"]), report["module_file"])
             self.assertTrue(report["module_file"].endswith(".cp311-win_amd64.pyd"), report["module_file"])
             check_solved_and_baked(self, report)
-            print("[wine] %s, Windows bpy 4.5.15: the %s zip installed as %s, solved and baked the cube "
+            print("[summary] wine %s, Windows bpy 4.5.15: the %s zip installed as %s, solved and baked the cube "
                   "(%d elements); against Cycles: mean %.1f %%, worst cell %.1f %%" % (
                       wine.version(), kind, report["module"], report["elements"], 100 * mean, 100 * region),
                   flush=True)
