@@ -113,7 +113,7 @@ STOPPED_WHILE_LINKING = {
 }
 
 
-def rough_look_hint(stats):
+def rough_look_hint(visibility, stats):
     """What the result is when the solve stopped while it was linking (before
     its first pass): the ray pass's rough look (native/core/solve/ray_pass.h),
     right in brightness but blotchy, and what to change."""
@@ -121,8 +121,9 @@ def rough_look_hint(stats):
     if not why or stats.get("passes", 0) or not stats.get("ray_pass_rays"):
         return ""
     return ("Rough look only: %s while linking (%.0f s), so the result is the quick first look traced by rays: "
-            "right in brightness, blotchy in detail. For the solved result raise the Time Limit, or lower "
-            "Quality, or use Visibility 'Sampled'" % (why, stats.get("seconds_linking", 0.0)))
+            "right in brightness, blotchy in detail. For the solved result raise the Time Limit or lower "
+            "Quality%s" % (why, stats.get("seconds_linking", 0.0),
+                           ", or use Visibility 'Sampled'" if visibility == 'exact' else ""))
 
 
 def prepare(context, solver, started=None):
@@ -305,7 +306,7 @@ def record(context, job, stats, skipped_objects, warnings):
     note = export.unmodelled_message(job.exported.unmodelled)
     if note:
         warnings.append(note)
-    for hint in (rough_look_hint(stats), visibility_hint(job.options.get("visibility"), stats)):
+    for hint in (rough_look_hint(job.options.get("visibility"), stats), visibility_hint(job.options.get("visibility"), stats)):
         if hint:
             warnings.append(hint)
     coincident = export.coincident_message(job.exported, job.native_scene.coincident_faces)

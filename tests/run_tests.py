@@ -68,6 +68,7 @@ NATIVE_ONCE = {
     "test_image_metric.py": "the study's _image_metric is built for Debian's Python alone",
     "test_solver.py": "the solver's numerics", "test_energy.py": "the solver's energy balance",
     "test_contact.py": "the solver's contact meshing", "test_format.py": "the C++ sources' format",
+    "test_rough_look.py": "the ray pass's numerics",
 }
 # The package-level check of a --check-blender Blender.
 PACKAGE_CHECK = {"test_package.py"}

@@ -385,16 +385,19 @@ class DoubledWallTest(unittest.TestCase):
 class RoughLookHintTest(unittest.TestCase):
     def test_a_solve_stopped_while_linking_says_its_result_is_the_rough_look(self):
         stats = {"stopped_by": "time_budget", "passes": 0, "ray_pass_rays": 32, "seconds_linking": 88.4}
-        hint = pipeline.rough_look_hint(stats)
+        hint = pipeline.rough_look_hint("sampled", stats)
         self.assertIn("Rough look only: the Time Limit ran out while linking (88 s)", hint)
         self.assertIn("raise the Time Limit", hint)
-        self.assertIn("the memory limit was reached", pipeline.rough_look_hint(dict(stats, stopped_by="memory")))
-        self.assertIn("it was cancelled", pipeline.rough_look_hint(dict(stats, stopped_by="cancel")))
+        self.assertNotIn("Sampled", hint)
+        self.assertIn("use Visibility 'Sampled'", pipeline.rough_look_hint("exact", stats))
+        self.assertIn("the memory limit was reached",
+                      pipeline.rough_look_hint("sampled", dict(stats, stopped_by="memory")))
+        self.assertIn("it was cancelled", pipeline.rough_look_hint("sampled", dict(stats, stopped_by="cancel")))
         # A pass finished, or the solve converged: the result is solved.
-        self.assertEqual(pipeline.rough_look_hint(dict(stats, passes=1)), "")
-        self.assertEqual(pipeline.rough_look_hint(dict(stats, stopped_by="quality")), "")
+        self.assertEqual(pipeline.rough_look_hint("sampled", dict(stats, passes=1)), "")
+        self.assertEqual(pipeline.rough_look_hint("sampled", dict(stats, stopped_by="quality")), "")
         # Stopped before the ray pass finished: nothing was kept to describe.
-        self.assertEqual(pipeline.rough_look_hint(dict(stats, ray_pass_rays=0)), "")
+        self.assertEqual(pipeline.rough_look_hint("sampled", dict(stats, ray_pass_rays=0)), "")
 
 
 class VisibilityHintTest(unittest.TestCase):

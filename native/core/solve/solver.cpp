@@ -327,6 +327,11 @@ void Solver::link_initially() {
            0.05 + 0.05 * static_cast<double>(end) / static_cast<double>(candidates.size()));
   }
   candidates = {};
+  if (linking_stopped()) {  // the rough look stands (run()); the lights' links would cost as much
+                            // again
+    stats_.seconds_linking = seconds_since(start);
+    return;
+  }
   cluster_links_ = std::move(initial.clusters);
   sort_by_receiver(cluster_links_);
   cluster_links_.shrink_to_fit();
