@@ -71,8 +71,8 @@ bool reflects(const Hierarchy& h, const Element& e) { return luminance(h.reflect
 }  // namespace
 
 int ray_pass_rays(std::size_t reflecting) {
-  const double share = 2.0e6 / static_cast<double>(std::max<std::size_t>(reflecting, 1));
-  return std::clamp(static_cast<int>(share) / 16 * 16, 32, 4096);
+  const double share = 1.0e6 / static_cast<double>(std::max<std::size_t>(reflecting, 1));
+  return std::clamp(static_cast<int>(share) / 16 * 16, 32, 2048);
 }
 
 namespace {

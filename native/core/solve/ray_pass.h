@@ -43,7 +43,7 @@ struct RayPass {
 };
 
 // Rays per element for a scene of `reflecting` top-level elements: about
-// two million in all, between 32 and 4,096 each (as many shadow rays again).
+// a million in all, between 32 and 2,048 each (as many shadow rays again).
 int ray_pass_rays(std::size_t reflecting);
 
 // `occluders`: what casts shadows (the lights' shadow rays). Returns
