@@ -40,6 +40,38 @@ float end_margin(const dvec3& from, const dvec3& to) {
   return static_cast<float>(std::min(0.25, 1e-5 + 1e-6 * magnitude / length));
 }
 
+// A query context that skips the faces `skip_a` and `skip_b` (`face`: the
+// triangles' faces). Embree copies nothing: it must outlive the query.
+FilterContext filter_context(const std::uint32_t* face, std::uint32_t skip_a,
+                             std::uint32_t skip_b) {
+  FilterContext context;
+  rtcInitIntersectContext(&context.embree);
+  context.embree.filter = skip_own_faces;
+  context.face = face;
+  context.skip_a = skip_a;
+  context.skip_b = skip_b;
+  return context;
+}
+
+// The segment from `from` to `to` as an Embree ray, kept end_margin from both ends.
+RTCRay segment_ray(const dvec3& from, const dvec3& to) {
+  const float margin = end_margin(from, to);
+  RTCRay ray;
+  ray.org_x = static_cast<float>(from.x);
+  ray.org_y = static_cast<float>(from.y);
+  ray.org_z = static_cast<float>(from.z);
+  ray.dir_x = static_cast<float>(to.x - from.x);
+  ray.dir_y = static_cast<float>(to.y - from.y);
+  ray.dir_z = static_cast<float>(to.z - from.z);
+  ray.tnear = margin;
+  ray.tfar = 1.0f - margin;
+  ray.time = 0.0f;
+  ray.mask = 0xFFFFFFFFu;
+  ray.id = 0;
+  ray.flags = 0;
+  return ray;
+}
+
 }  // namespace
 
 // One Embree device for the process: scenes are made per solve (or per Python
@@ -115,26 +147,8 @@ RayScene::~RayScene() {
 bool RayScene::occluded(const dvec3& from, const dvec3& to, std::uint32_t skip_a,
                         std::uint32_t skip_b) const {
   if (face_.empty() || from == to) return false;
-  FilterContext context;
-  rtcInitIntersectContext(&context.embree);
-  context.embree.filter = skip_own_faces;
-  context.face = face_.data();
-  context.skip_a = skip_a;
-  context.skip_b = skip_b;
-  const float margin = end_margin(from, to);
-  RTCRay ray;
-  ray.org_x = static_cast<float>(from.x);
-  ray.org_y = static_cast<float>(from.y);
-  ray.org_z = static_cast<float>(from.z);
-  ray.dir_x = static_cast<float>(to.x - from.x);
-  ray.dir_y = static_cast<float>(to.y - from.y);
-  ray.dir_z = static_cast<float>(to.z - from.z);
-  ray.tnear = margin;
-  ray.tfar = 1.0f - margin;
-  ray.time = 0.0f;
-  ray.mask = 0xFFFFFFFFu;
-  ray.id = 0;
-  ray.flags = 0;
+  FilterContext context = filter_context(face_.data(), skip_a, skip_b);
+  RTCRay ray = segment_ray(from, to);
   rtcOccluded1(scene_, &context.embree, &ray);
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
 }
@@ -143,26 +157,10 @@ std::uint32_t RayScene::first_hit(const dvec3& from, const dvec3& to, std::uint3
                                   float& along) const {
   along = 1.0f;
   if (face_.empty() || from == to) return kNoFace;
-  FilterContext context;
-  rtcInitIntersectContext(&context.embree);
-  context.embree.filter = skip_own_faces;
-  context.face = face_.data();
-  context.skip_a = skip;
-  const float margin = end_margin(from, to);
+  FilterContext context = filter_context(face_.data(), skip, kNoFace);
   RTCRayHit query;
-  RTCRay& ray = query.ray;
-  ray.org_x = static_cast<float>(from.x);
-  ray.org_y = static_cast<float>(from.y);
-  ray.org_z = static_cast<float>(from.z);
-  ray.dir_x = static_cast<float>(to.x - from.x);
-  ray.dir_y = static_cast<float>(to.y - from.y);
-  ray.dir_z = static_cast<float>(to.z - from.z);
-  ray.tnear = margin;
-  ray.tfar = 1.0f - margin;
-  ray.time = 0.0f;
-  ray.mask = 0xFFFFFFFFu;
-  ray.id = 0;
-  ray.flags = 0;
+  query.ray = segment_ray(from, to);
+  const RTCRay& ray = query.ray;
   query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   query.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(scene_, &context.embree, &query);
@@ -183,12 +181,7 @@ void RayScene::occluded(const dvec3& from, std::span<const dvec3> to,
     for (std::size_t i = 0; i < count; ++i) blocked[i] = occluded(from, to[i], skip_a, skip_b);
     return;
   }
-  FilterContext context;
-  rtcInitIntersectContext(&context.embree);
-  context.embree.filter = skip_own_faces;
-  context.face = face_.data();
-  context.skip_a = skip_a;
-  context.skip_b = skip_b;
+  FilterContext context = filter_context(face_.data(), skip_a, skip_b);
   // Coherent rays from one point: the packet shares its origin.
   alignas(32) RTCRay8 packet;
   alignas(32) int valid[8];
