@@ -17,8 +17,7 @@
 namespace radiosity {
 namespace {
 
-constexpr std::int32_t kNothing = -1;  // a ray that meets no light-carrying side
-constexpr double kTolerance = 1e-4;    // relative change of the total radiance
+constexpr double kTolerance = 1e-4;  // relative change of the total radiance
 constexpr int kMaxIterations = 1000;
 
 // Every patch, the lights' too (a ray that meets a lamp takes its emission),
@@ -161,9 +160,10 @@ RayPass ray_pass(const Hierarchy& hierarchy, const RayScene& occluders,
   pass.gathered.assign(count, Rgb(0.0));
   const auto rays = static_cast<std::size_t>(pass.rays);
   // Per element: the direct light of emitters, lights and sky (fixed), and
-  // the top-level element each cosine ray meets.
+  // the top-level element each cosine ray meets (kNone: the sky, or the back
+  // of a one-sided face).
   std::vector<Rgb> fixed(count, Rgb(0.0));
-  std::vector<std::int32_t> met(count * rays, kNothing);
+  std::vector<std::int32_t> met(count * rays, kNone);
   const Emitters emitters(hierarchy, root_element);
   const RayScene tracer = patch_rays(scene);
   const double reach = 2.0 * std::max(scene.diameter, 1e-300);
@@ -249,7 +249,7 @@ RayPass ray_pass(const Hierarchy& hierarchy, const RayScene& occluders,
             Rgb h(0.0);
             for (std::size_t k = 0; k < rays; ++k) {
               const std::int32_t m = met[i * rays + k];
-              if (m != kNothing) h += reflected[static_cast<std::size_t>(m)];
+              if (m != kNone) h += reflected[static_cast<std::size_t>(m)];
             }
             h = h / static_cast<double>(rays) + fixed[i];
             next[i] = hierarchy.reflectance(e) * h;

@@ -27,15 +27,14 @@
 #include <vector>
 
 #include "core/hierarchy/hierarchy.h"
-#include "core/solve/gather.h"
 #include "core/visibility/ray_scene.h"
 #include "radiosity/color.h"
 
 namespace radiosity {
 
 struct RayPass {
-  // Per top-level element (element ids below Hierarchy::root_count()): what it
-  // gathers from surfaces, uniform over it.
+  // Per top-level element (they are the first elements): what it gathers (H)
+  // from emitters, lights, sky and reflecting surfaces, uniform over it.
   std::vector<Rgb> gathered;
   int rays = 0;        // per reflecting top-level element
   int iterations = 0;  // Jacobi iterations
