@@ -166,16 +166,19 @@ def draw_solve(layout, context):
         draw_wrapped(box, context, EDIT_WARNING, icon='ERROR', indent=BOX_PAD)
 
 
-def draw_oracle_and_quality(layout, settings):
-    """The oracle, the Quality slider and what it means for that oracle."""
+def draw_oracle_and_quality(layout, context, settings):
+    """The oracle, the Quality slider and what it means for that oracle: a
+    headline and, greyed under it, what its number is."""
     col = layout.column()
     col.prop(settings, "oracle")
     col.prop(settings, "quality", slider=True)
-    meaning = quality_text(settings, native.loaded())
+    meaning, detail = quality_text(settings, native.loaded())
     if meaning:
         row = col.row()
         row.alignment = 'RIGHT'
         row.label(text=meaning)
+    if detail:
+        draw_wrapped(col, context, detail).active = False
     return col
 
 
@@ -213,7 +216,7 @@ class VIEW3D_PT_radiosity(Panel):
         col = layout.column()
         col.use_property_split = True
         col.use_property_decorate = False
-        draw_oracle_and_quality(col, context.scene.radiosity)
+        draw_oracle_and_quality(col, context, context.scene.radiosity)
 
 
 class RENDER_PT_radiosity_quality(RadiosityPanel, Panel):
@@ -228,7 +231,7 @@ class RENDER_PT_radiosity_quality(RadiosityPanel, Panel):
         layout.use_property_split = True
         layout.use_property_decorate = False
 
-        col = draw_oracle_and_quality(layout, settings)
+        col = draw_oracle_and_quality(layout, context, settings)
         col.prop(settings, "min_element_size")
 
         col = layout.column()

@@ -411,7 +411,8 @@ class PanelTest(unittest.TestCase):
 
     def test_quality_reads_in_each_oracles_terms_and_fits(self):
         # The line under the slider states the threshold Quality sets, so it moves
-        # with the slider; every oracle's text and name fit the default width.
+        # with the slider, and the greyed lines under it what its number is; every
+        # oracle's text and name fit the default width.
         settings = bpy.context.scene.radiosity
         saved = settings.oracle, settings.quality
         rad = native.load()
@@ -426,17 +427,42 @@ class PanelTest(unittest.TestCase):
                     with self.subTest(oracle=oracle, quality=quality):
                         layout = self.draw(ui.RENDER_PT_radiosity_quality)
                         self.assert_fits(layout)
-                        self.assertIn(texts[-1], layout.record["labels"])
-                self.assertNotEqual(texts[0], texts[1], oracle)
-            settings.oracle, settings.quality = 'NOTICEABLE', 0.5
-            jnd = rad.quality_threshold("noticeable", 0.5)
-            self.assertIn("Differences below %.2g JND" % jnd,
-                          self.draw(ui.RENDER_PT_radiosity_quality).record["labels"])
+                        headline, detail = texts[-1]
+                        self.assertIn(headline, layout.record["labels"])
+                        self.assertTrue(detail)
+                        # The detail, wrapped, is there word for word.
+                        labels = " ".join(layout.record["labels"])
+                        self.assertIn(" ".join(detail.split()), labels)
+                self.assertNotEqual(texts[0][0], texts[1][0], oracle)
             settings.quality = 0.0
             self.assertIn("No refinement: the coarsest lighting",
                           self.draw(ui.RENDER_PT_radiosity_quality).record["labels"])
         finally:
             settings.oracle, settings.quality = saved
+
+    def test_quality_numbers_are_the_oracles_thresholds(self):
+        # At the default quality (0.5) each threshold is the geometric mean of its
+        # oracle's ends (solver.cpp, threshold_range) and each text says what it
+        # allows the eye: per cent of the brightness, for Standard and Gradient on a
+        # patch of 1 % of the scene's area (threshold / 0.01 and / 0.1), and for
+        # Noticeable in JND and per cent (2 % a JND).
+        rad = native.load()
+        meaning = {oracle: quality_meaning.quality_meaning(oracle, rad.quality_threshold(oracle.lower(), 0.5))
+                   for oracle in ('STANDARD', 'PERCEPTUAL', 'GRADIENT', 'NOTICEABLE')}
+        self.assertAlmostEqual(rad.quality_threshold("standard", 0.5), 10 ** -4.5)  # 3.2e-5
+        self.assertEqual(meaning['STANDARD'][0], "Light uneven below 0.32 %")
+        self.assertIn("across a patch of 1 % of the area", meaning['STANDARD'][1])
+        self.assertAlmostEqual(rad.quality_threshold("gradient", 0.5), 5e-3)
+        self.assertEqual(meaning['GRADIENT'][0], "Light creases below 5.0 %")
+        self.assertIn("over 1 % of the area", meaning['GRADIENT'][1])
+        self.assertEqual(meaning['PERCEPTUAL'][0], "Shading errors below 6.3 %")
+        self.assertAlmostEqual(rad.quality_threshold("noticeable", 0.5), 10 ** 0.5 / 2)  # 1.58 JND
+        self.assertEqual(meaning['NOTICEABLE'],
+                         ("Differences below 1.6 JND",
+                          "about 3.2 % of the brightness around (1 JND, the least step seen: 2 %)"))
+        # Larger or smaller numbers keep two digits and no exponent.
+        self.assertEqual(quality_meaning.quality_meaning('STANDARD', 1e-7)[0], "Light uneven below 0.001 %")
+        self.assertEqual(quality_meaning.quality_meaning('STANDARD', 1e-2)[0], "Light uneven below 100 %")
 
     def test_long_texts_are_wrapped_to_fit(self):
         stats = bpy.context.scene.radiosity.stats
