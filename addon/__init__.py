@@ -67,6 +67,7 @@ def register():
     ui.register()  # menu entries, the progress bar's property
     solve_reuse.register()
     view_sync.register()
+    operators.register()  # an undo during a solve stops it
     # Try the native module now so the panel can say at once if it is unusable;
     # registration itself never depends on it.
     try:
@@ -76,6 +77,7 @@ def register():
 
 
 def unregister():
+    operators.unregister()
     view_sync.unregister()
     solve_reuse.unregister()
     ui.unregister()

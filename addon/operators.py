@@ -4,7 +4,9 @@
 execute runs the whole solve synchronously (background mode, scripts, tests);
 invoke, from the UI, runs the same solve on a worker thread with a progress
 bar, status text and ESC to cancel (the solver then returns its last complete
-pass, which is baked). Both paths run the steps of pipeline.py: `prepare`
+pass, which is baked). The window stays usable meanwhile: the modal handler
+passes every event on but Esc and the keys of what must wait for the solve
+(LOCKED_OPERATORS); an undo from a menu stops the solve. Both paths run the steps of pipeline.py: `prepare`
 (export, on the main thread), the native solve, and `conclude` (bake, on the
 main thread): bpy is never touched from the worker. Every failure becomes a
 report and {'CANCELLED'}, never a traceback, and leaves the scene as it was.
@@ -20,6 +22,7 @@ import time
 import traceback
 
 import bpy
+from bpy.app.handlers import persistent
 from bpy.types import Operator
 
 from . import bake, live_pacing, native, pipeline, result_state, solve_reuse
@@ -45,6 +48,75 @@ def refused_while_solving(operator):
         return False
     operator.poll_message_set("A radiosity solve is running (Esc cancels it)")
     return True
+
+
+# What waits while an interactive solve runs: its keys do nothing (the status bar
+# says why). Undo and redo would take the scene back under the passes the solve
+# shows, deleting or switching the mode of an object would pull its meshes from
+# under the bake, and a repeat would start the same again. The solve's own
+# buttons (Solve, Toggle, Remove) are greyed by their polls.
+LOCKED_OPERATORS = {
+    "ed.undo": "Undo", "ed.redo": "Redo", "ed.undo_history": "Undo History",
+    "screen.repeat_last": "Repeat Last", "screen.repeat_history": "Repeat History",
+    "object.delete": "Delete", "outliner.delete": "Delete", "object.join": "Join",
+    "object.editmode_toggle": "Edit Mode", "object.mode_set": "Mode switching",
+    "object.transfer_mode": "Mode switching",
+}
+LOCKED_MENUS = {"VIEW3D_MT_object_mode_pie": "Mode switching"}
+# What undoing through a menu (which no key passes) does to a running solve.
+UNDONE = "Undo during the radiosity solve stopped it: the scene is as the undo left it"
+
+
+def _modifier_matches(wanted, pressed, any_modifier):
+    # KeyMapItem modifiers: bools before 3.2, then -1 (any), 0 or 1.
+    return any_modifier or wanted == -1 or bool(wanted) == pressed
+
+
+def locked_keys(keyconfig):
+    """[(event type, shift, ctrl, alt, oskey, any, what)] of the keymap items of
+    `keyconfig` that call a locked operator or menu."""
+    keys = []
+    for keymap in keyconfig.keymaps if keyconfig is not None else ():
+        for item in keymap.keymap_items:
+            what = LOCKED_OPERATORS.get(item.idname)
+            if what is None and item.idname in {"wm.call_menu", "wm.call_menu_pie"}:
+                what = LOCKED_MENUS.get(getattr(item.properties, "name", ""))
+            if what is not None and item.active and item.key_modifier == 'NONE':
+                keys.append((item.type, item.shift, item.ctrl, item.alt, item.oskey, item.any, what))
+    return keys
+
+
+def locked_by(keys, event):
+    """What `event` would start that must wait for the solve, or None."""
+    for kind, shift, ctrl, alt, oskey, any_modifier, what in keys:
+        if kind == event.type and all(_modifier_matches(w, p, any_modifier) for w, p in (
+                (shift, event.shift), (ctrl, event.ctrl), (alt, event.alt), (oskey, event.oskey))):
+            return what
+    return None
+
+
+@persistent
+def _undone(*_args):
+    # An undo or redo while a solve runs (from a menu: its keys are locked)
+    # replaced the scene under it: the solve stops and bakes nothing.
+    job = _running_job
+    if job is not None:
+        job.undone = True
+
+
+UNDO_HANDLERS = (bpy.app.handlers.undo_post, bpy.app.handlers.redo_post)
+
+
+def register():
+    for handlers in UNDO_HANDLERS:
+        if _undone not in handlers:
+            handlers.append(_undone)
+
+
+def unregister():
+    for handlers in UNDO_HANDLERS:
+        if _undone in handlers:
+            handlers.remove(_undone)
 
 
 def pass_printer():
@@ -113,6 +185,7 @@ class RADIOSITY_OT_solve(Operator):
         self._pacing = live_pacing.LivePacing()
         self._status, self._status_time = "", 0.0  # the status text shown, and when
         self._token = solver.CancelToken()
+        self._locked_keys = locked_keys(context.window_manager.keyconfigs.user)
         self._thread = threading.Thread(target=pipeline.work, args=(solver, job, self._token),
                                         name="radiosity-solve", daemon=True)
         wm = context.window_manager
@@ -128,18 +201,33 @@ class RADIOSITY_OT_solve(Operator):
             self._token.cancel()
             context.workspace.status_text_set("Radiosity: cancelling, keeping the last complete pass")
             return {'RUNNING_MODAL'}
-        # Any timer tick will do (other timers tick too; checking is cheap).
+        if self._job.undone:
+            return self._drop_undone(context)
+        # Any timer tick will do (other timers tick too, and pass on to their owners).
         if event.type == 'TIMER':
             alive = self._thread.is_alive()
             self._poll(context)
-            if alive:
-                return {'RUNNING_MODAL'}
+            # The bake waits for Object Mode (a mode switched from a menu).
+            if alive or context.mode != 'OBJECT':
+                return {'PASS_THROUGH'}
             self._stop_modal(context)
             return self._conclude(context, self._job, self._live)
-        if event.type in {'MIDDLEMOUSE', 'WHEELUPMOUSE', 'WHEELDOWNMOUSE', 'TRACKPADPAN',
-                          'TRACKPADZOOM', 'MOUSEMOVE', 'INBETWEEN_MOUSEMOVE'}:
-            return {'PASS_THROUGH'}  # let the user look around while it solves
-        return {'RUNNING_MODAL'}
+        what = locked_by(self._locked_keys, event)
+        if what is not None:
+            if event.value == 'PRESS':
+                self.report({'WARNING'}, "%s waits until the radiosity solve ends (Esc cancels it)" % what)
+            return {'RUNNING_MODAL'}
+        return {'PASS_THROUGH'}  # the rest of the interface works as ever
+
+    def _drop_undone(self, context):
+        """An undo replaced the scene: stop the solver and leave the scene as the
+        undo made it (what the passes showed is gone or was the undo's)."""
+        self._token.cancel()
+        self._thread.join()
+        self._stop_modal(context)
+        self._live = None
+        self.report({'WARNING'}, UNDONE)
+        return {'CANCELLED'}
 
     def cancel(self, context):
         # Blender ends the operator (file closed, window gone): stop the worker
@@ -156,8 +244,10 @@ class RADIOSITY_OT_solve(Operator):
         progress = job.monitor.progress()
         if progress is not None:
             job.progress = progress
-        # A newer pass replaces one waiting in the monitor while the pacing says wait.
-        result = job.monitor.take_pass_result() if self._pacing.may_show() else None
+        # A newer pass replaces one waiting in the monitor while the pacing says wait;
+        # none is shown outside Object Mode (an object edited from a menu).
+        may_show = self._pacing.may_show() and context.mode == 'OBJECT'
+        result = job.monitor.take_pass_result() if may_show else None
         if result is not None:
             try:
                 began = time.perf_counter()

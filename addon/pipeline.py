@@ -53,6 +53,7 @@ class Job:
     result: object = None
     error: BaseException = None
     started: float = field(default_factory=time.perf_counter)  # when the Solve began
+    undone: bool = False  # an undo replaced the scene while it solved (operators._undone)
 
 
 def native_options(options, total_area):

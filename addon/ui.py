@@ -26,7 +26,7 @@ from .progress_text import progress_fraction, progress_texts
 from .quality_meaning import quality_text
 
 EDIT_WARNING = "Edits to radiosity results are replaced by the next Solve"
-SOLVING_LOCK = "While it solves, the window only pans, orbits and zooms the views"
+SOLVING_LOCK = "The window works meanwhile; Undo, Delete and mode switches wait for the end"
 # Width of a character of the UI font at scale 1, above the widest lines of the texts
 # drawn here (5.4 px in 3.x's DejaVu Sans; 4.x's Inter is a little wider), what a
 # panel's layout is narrower than its region, and the room around a label's text,
@@ -114,7 +114,8 @@ def draw_progress(layout, context, progress):
     if text == short and count:
         col.label(text=count)  # below the bar where the bar has no room for it
     col.label(text="Esc to cancel", icon='CANCEL')
-    # The solve's modal handler takes every event but view navigation: say so.
+    # The solve's modal handler passes every event on but the keys of what must
+    # wait (operators.LOCKED_OPERATORS): say so.
     draw_wrapped(col, context, SOLVING_LOCK, icon='LOCKED')
 
 

@@ -1,7 +1,7 @@
 """Blender side of test_interactive.py: the interactive solve in a real window.
 
     xvfb-run blender --factory-startup FILE.blend \
-        --python interactive_solve.py -- ADDON_DIR run|cancel|cancel_after:SECONDS [SHOTS_DIR]
+        --python interactive_solve.py -- ADDON_DIR run|cancel|cancel_after:SECONDS|clicks [SHOTS_DIR]
 
 Once the window is idle (its first draws compile shaders, seconds of CPU under
 software OpenGL), invokes radiosity.solve with INVOKE_DEFAULT in the 3D view
@@ -10,7 +10,11 @@ display with xdotool (after the first pass, or SECONDS after the click), waits
 for the bake and prints one line "RESULT <json>" before quitting. While the
 solve runs a timer watches it as a user would: the progress it reports, how
 often a UI timer gets to run, the result meshes changing pass by pass, and
-the elements refined 2, 4 and 6 s after the click. With SHOTS_DIR it writes
+the elements refined 2, 4 and 6 s after the click. "clicks": once a pass is
+shown, real events on the X display as a user would send them: Ctrl+Z (which
+must wait: the solve's undo lock), then Z's pie menu in the 3D view and a click
+on its Material Preview; when the view's shading reads Material Preview while
+the solve still runs, Esc. With SHOTS_DIR it writes
 SHOTS_DIR/solve_in_progress.png, the window when the first pass is shown
 (the Properties editor scrolled to the Radiosity panel).
 
@@ -46,7 +50,7 @@ from radiosity import operators  # noqa: E402  (the add-on, enabled above)
 bpy.context.preferences.system.viewport_aa = 'OFF'  # see above; --factory-startup saves no preferences
 state = {"start": None, "invoke": None, "fractions": [], "by_pass": [], "last_progress": None,
          "ticks": 0, "running_seconds": 0.0, "mesh_states": [], "updates_while_running": 0,
-         "leaves_after": {}}
+         "leaves_after": {}, "clicks": None}
 MARKS = (2.0, 4.0, 6.0)  # seconds after the click at which the refined elements are noted
 
 
@@ -81,10 +85,18 @@ def screenshot_in_progress():
     state["screenshot_at"] = time.time() - state["start"]
 
 
+def view_3d():
+    return next(a for a in window().screen.areas if a.type == 'VIEW_3D')
+
+
 def start():
     win = window()
-    area = next(a for a in win.screen.areas if a.type == 'VIEW_3D')
-    bpy.context.scene.radiosity.quality = 1.0 if MODE.startswith("cancel") else 0.5
+    area = view_3d()
+    bpy.context.scene.radiosity.quality = 1.0 if MODE.startswith("cancel") or MODE == "clicks" else 0.5
+    if MODE == "clicks":
+        # An undo step to go back to (the file as loaded has none): Ctrl+Z, if it
+        # were not locked, would take the scene back to quality 0.5, without the pass.
+        bpy.ops.ed.undo_push(message="Radiosity quality 1")
     with bpy.context.temp_override(window=win, area=area):
         state["invoke"] = sorted(bpy.ops.radiosity.solve('INVOKE_DEFAULT'))
     state["start"] = time.time()
@@ -126,6 +138,36 @@ def watch():
             state["updates_while_running"] += 1
             if SHOTS and "screenshot_at" not in state:
                 screenshot_in_progress()
+    return 0.05
+
+
+def send_clicks():
+    # Once a pass is shown: Ctrl+Z, then the shading pie (Z) over the 3D view,
+    # the pointer 150 px down (the pie's south item, Material Preview) and a click,
+    # all on the X display, without waiting (the window must handle them).
+    if state["start"] is None or not state["mesh_states"]:
+        return 0.05
+    win, area = window(), view_3d()
+    x, y = area.x + area.width // 2, win.height - (area.y + area.height // 2)
+    subprocess.Popen(["xdotool", "mousemove", str(x), str(y), "sleep", "0.3", "key", "ctrl+z", "sleep", "0.3",
+                      "key", "z", "sleep", "0.8", "mousemove_relative", "0", "150", "sleep", "0.5", "click", "1"])
+    state["clicks"] = {"sent_at": time.time() - state["start"], "shading": [], "polygons": result_polygons()}
+    bpy.app.timers.register(watch_shading, first_interval=0.05)
+    return None
+
+
+def watch_shading():
+    # The view's shading as the solve goes on; Esc once it reads Material Preview.
+    progress, clicks = operators.running_progress(), state["clicks"]
+    shading = view_3d().spaces.active.shading.type
+    if not clicks["shading"] or clicks["shading"][-1][0] != shading:
+        clicks["shading"].append([shading, progress is not None, result_polygons(),
+                                  bpy.context.scene.radiosity.quality, (progress or {}).get("pass")])
+    if progress is None:
+        return None
+    if shading == 'MATERIAL':
+        press_escape()
+        return None
     return 0.05
 
 
@@ -174,7 +216,7 @@ def check():
         "running_seconds": state["running_seconds"], "updates_while_running": state["updates_while_running"],
         "final_polygons": result_polygons(), "escaped_at": state.get("escaped_at"),
         "leaves_after": state["leaves_after"], "idle_after": state.get("idle_after"),
-        "screenshot_at": state.get("screenshot_at"),
+        "screenshot_at": state.get("screenshot_at"), "clicks": state["clicks"],
     }), flush=True)
     bpy.ops.wm.quit_blender()
     return None
@@ -203,6 +245,8 @@ bpy.app.timers.register(start_when_idle, first_interval=0.5)
 bpy.app.timers.register(watch, first_interval=0.55)
 if MODE == "cancel":
     bpy.app.timers.register(escape, first_interval=0.6)
+elif MODE == "clicks":
+    bpy.app.timers.register(send_clicks, first_interval=0.6)
 elif MODE.startswith("cancel_after:"):
     bpy.app.timers.register(escape_after(float(MODE.split(":")[1])), first_interval=0.52)
 bpy.app.timers.register(check, first_interval=0.7)

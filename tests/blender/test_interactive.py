@@ -73,6 +73,32 @@ class InteractiveSolveTest(unittest.TestCase):
         # the tests run with, each redraw of the window costs tens of
         # milliseconds and bounds it (measured 7-8.5 Hz of the 20 asked).
 
+    def test_the_window_works_while_it_solves(self):
+        # Clicks reach the interface during a solve (the modal handler passes them
+        # on): once a pass is shown, Ctrl+Z, then the shading pie (Z) and a click on
+        # Material Preview, real events on the X display; the view reads Material
+        # Preview while the solve still runs. Ctrl+Z waits (an undo step to go
+        # back to was made before the solve, at quality 0.5 without its passes): the
+        # quality and the pass shown are still there. Ordered by the events, not
+        # by time: whenever the window gets to them, the solve at quality 1 runs on
+        # until the Esc sent after the shading changed, which keeps a complete pass.
+        r = self.run_window("full_office", "clicks")
+        self.assertEqual(r["invoke"], ["RUNNING_MODAL"])
+        clicks = r["clicks"]
+        self.assertIsNotNone(clicks, r)
+        material = [seen for seen in clicks["shading"] if seen[0] == 'MATERIAL']
+        self.assertTrue(material, clicks)
+        shading, running, polygons, quality, _ = material[0]
+        self.assertTrue(running, clicks)  # changed while the solve ran
+        self.assertGreater(polygons, 0, clicks)  # the pass shown stayed: no undo
+        self.assertAlmostEqual(quality, 1.0, places=6, msg=clicks)
+        self.assertEqual(r["quality"], 1.0)
+        self.assertTrue(r["valid"], r)
+        self.assertEqual(r["status"], "Cancelled (last complete pass kept)")
+        self.assertGreater(r["final_polygons"], 0)
+        print("clicks during the solve: shading %s, Esc kept %d elements"
+              % ([seen[0] for seen in clicks["shading"]], r["elements"]))
+
     def test_two_sided_faces_do_not_speckle(self):
         # Each side of a two-sided face is its own polygon, a hair in front of
         # the other: in Solid view the two fight for the depth buffer and closed
