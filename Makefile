@@ -75,7 +75,7 @@ scenes: build
 demo: build
 	@$(PYTHON) scenes/demo.py --build $(BUILD) --blender $(BLENDER_EXE) --scene $(SCENE)
 
-# The Blender 4.2+ extension zip and the legacy add-on zip of each platform (tools/package.py):
+# The zip of each platform, one for every Blender (an extension in 4.2+, an add-on in 3.x; tools/package.py):
 # Linux always; Windows and macOS where `make test-platforms` made their dependencies
 # (their modules are brought up to date first: tools/cross_build.py --if-deps).
 package: build
@@ -88,7 +88,7 @@ package: build
 # its modules for each CPython (tools/cross_build.py; macOS ones signed with rcodesign,
 # built once with cargo), the zips, then tests/platforms: each module's imports, exports
 # and signature, and the Windows ones run under Wine (tests/native; Windows bpy 4.5
-# installing both zips, solving and baking).
+# installing the zip through both installers, solving and baking).
 test-platforms: build
 	@bash .ci/install-deps.sh platforms
 	@$(PYTHON) tools/cross_build.py --build $(BUILD) --jobs $(JOBS)

@@ -59,10 +59,10 @@ def what_to_do(from_source):
         here += " on %s %s" % (platform.system(), platform.machine())
     return ("this copy is built for Linux x64 and Python %s, and this Blender runs %s. "
             "Reinstall the add-on from the zip for Linux x64 and your Blender: "
-            "radiosity-%s-linux_x64.zip (the extension) for Blender 4.2 and later, "
-            "radiosity-%s-legacy_linux_x64.zip for Blender 3.4 to 4.1. Both need a Blender "
+            "radiosity-%s-linux_x64.zip, the same for every Blender from 3.4 (an extension "
+            "in 4.2 and later, an add-on before). It needs a Blender "
             "whose Python is %s; others need a build of their own (README, "
-            "\"Which Blender a build works in\")" % (built, here, _version(), _version(), built))
+            "\"Which Blender a build works in\")" % (built, here, _version(), built))
 
 
 def error():

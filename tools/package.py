@@ -1,23 +1,24 @@
 #!/usr/bin/env python3
-"""`make package`: the installable zips of the assembled add-on (BUILD/addon/radiosity),
-two per platform: linux-x64 always, windows-x64, macos-arm64 and macos-x64 when their
+"""`make package`: the installable zip of the assembled add-on (BUILD/addon/radiosity),
+one per platform: linux-x64 always, windows-x64, macos-arm64 and macos-x64 when their
 modules are built (tools/cross_build.py: `make package` builds them where their
 dependencies exist, `make test-platforms` first makes those).
 
     python3 tools/package.py --build build [--require-all]
 
-For each PLATFORM (Blender's names; a zip name has _ for -):
-- BUILD/radiosity-VERSION-PLATFORM.zip, the Blender 4.2+ extension: the package's
-  files at the top of the zip with blender_manifest.toml, whose `platforms` lists
-  PLATFORM alone, as Blender's own `extension build --split-platforms` lays it out;
-  installed from Preferences > Get Extensions > Install from Disk, or
-  `blender --command extension install-file`.
-- BUILD/radiosity-VERSION-legacy_PLATFORM.zip, the add-on for Blender 3.x to 4.1:
-  the folder radiosity/ (bl_info in __init__.py), without the manifest; installed
-  from Preferences > Add-ons > Install.
-
-Each holds the add-on's Python files and the platform's compiled modules, one per
-CPython version side by side (Python imports the one whose suffix is its own).
+BUILD/radiosity-VERSION-PLATFORM.zip (a zip name has _ for -) holds one folder,
+radiosity/, with the add-on's Python files (bl_info in __init__.py), the platform's
+compiled modules, one per CPython version side by side (Python imports the one whose
+suffix is its own), and blender_manifest.toml, whose `platforms` lists PLATFORM
+alone. So the one zip installs in every Blender:
+- 4.2 and later, as an extension (Preferences > Get Extensions > Install from Disk,
+  or `blender --command extension install-file`): the installer takes a manifest
+  in the zip's one top-level folder as it takes one at the top
+  (bl_pkg's pkg_zipfile_detect_subdir_or_none);
+- 3.x to 4.1, as an add-on (Preferences > Add-ons > Install): the folder with its
+  __init__.py is the add-on, the manifest a file it ignores. A zip with the files
+  at its top (as `extension build` lays them out) dropped them loose into
+  scripts/addons/ there.
 Prints the paths.
 """
 
@@ -45,10 +46,13 @@ def package_files(folder):
             yield path, rel.as_posix()
 
 
-def zip_name(manifest, platform, kind):
-    """radiosity-0.1.0-windows_x64.zip (kind "extension") or radiosity-0.1.0-legacy_windows_x64.zip."""
-    return "%s-%s-%s%s.zip" % (manifest["id"], manifest["version"], "legacy_" if kind == "legacy" else "",
-                               platform.replace("-", "_"))
+# The folder that holds the package inside the zip: the add-on's module name in 3.x.
+FOLDER = "radiosity/"
+
+
+def zip_name(manifest, platform):
+    """radiosity-0.1.0-windows_x64.zip."""
+    return "%s-%s-%s.zip" % (manifest["id"], manifest["version"], platform.replace("-", "_"))
 
 
 def platform_manifest(text, platform):
@@ -86,7 +90,7 @@ def platform_entries(build, folder, platform):
 
 
 def build_packages(build, require_all=False):
-    """{platform: (extension zip, legacy zip)} of every platform whose modules are built."""
+    """{platform: zip} of every platform whose modules are built."""
     folder = Path(build).resolve() / "addon" / "radiosity"
     if not (folder / MANIFEST).exists() or not list(folder.glob("_radiosity*.so")):
         raise SystemExit("error: no assembled add-on with its module in %s: run `make build` first" % folder)
@@ -100,11 +104,10 @@ def build_packages(build, require_all=False):
                                  "(tools/cross_build.py)" % platform)
             print("%s: not packaged (its modules are not built: `make test-platforms`)" % platform)
             continue
-        out = folder.parent.parent
-        extension = write_zip(out / zip_name(manifest, platform, "extension"), entries)
-        legacy = write_zip(out / zip_name(manifest, platform, "legacy"),
-                           [(s, "radiosity/" + n) for s, n in entries if n != MANIFEST])
-        made[platform] = (extension, legacy)
+        target = folder.parent.parent / zip_name(manifest, platform)
+        made[platform] = write_zip(target, [(source, FOLDER + name) for source, name in entries])
+        # Earlier builds' second zip, the add-on alone for 3.x, would mislead.
+        (target.parent / zip_name(manifest, "legacy_" + platform)).unlink(missing_ok=True)
     return made
 
 
@@ -114,9 +117,8 @@ def main():
     parser.add_argument("--require-all", action="store_true",
                         help="fail unless every platform's modules are built")
     args = parser.parse_args()
-    for zips in build_packages(args.build, args.require_all).values():
-        for path in zips:
-            print("%s (%.1f MB)" % (path, path.stat().st_size / 1e6))
+    for path in build_packages(args.build, args.require_all).values():
+        print("%s (%.1f MB)" % (path, path.stat().st_size / 1e6))
     return 0
 
 

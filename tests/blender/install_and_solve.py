@@ -5,8 +5,9 @@ compare with Cycles, report.
         extension|legacy ZIP SCENES_DIR QUALITY REFERENCE_SAMPLES IMAGES_DIR
 
 Builds the bundled cube scene with Lambertian materials and renders its Cycles
-reference (REFERENCE_SAMPLES), installs ZIP with Blender's installer (extension:
-into the "user_default" repository; legacy: the add-on installer), enables it,
+reference (REFERENCE_SAMPLES), installs ZIP with one of Blender's installers
+(extension: into the "user_default" repository; legacy: the add-on installer of
+Preferences > Add-ons, as in 3.x), enables it,
 solves at QUALITY, renders the baked solution (16 samples, as test_cycles.py),
 saves both images as .npy in IMAGES_DIR and prints one line "RESULT <json>".
 """

@@ -646,8 +646,8 @@ class NativeMessageTest(unittest.TestCase):
         advice = native.what_to_do(False)
         self.assertNotIn("make", advice)
         version = ".".join(map(str, radiosity.bl_info["version"]))
-        self.assertIn("radiosity-%s-linux_x64.zip (the extension) for Blender 4.2 and later" % version, advice)
-        self.assertIn("radiosity-%s-legacy_linux_x64.zip for Blender 3.4 to 4.1" % version, advice)
+        self.assertIn("radiosity-%s-linux_x64.zip, the same for every Blender from 3.4" % version, advice)
+        self.assertNotIn("legacy", advice)
         self.assertIn("built for Linux x64 and Python 3.", advice)
 
     def test_panel_shows_what_to_do(self):

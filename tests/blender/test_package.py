@@ -13,9 +13,15 @@ test_cycles.py requires (its tolerances, quality and samples). This file is
 the package-level check `make test` runs in the Blenders between the oldest
 and the newest (tests/run_tests.py --check-blender).
 
-- The extension zip (Blender 4.2+): bpy.ops.extensions.package_install_files
+One zip (tools/package.py: the folder radiosity/ with bl_info and the manifest)
+through both of Blender's installers:
+- the extension installer (Blender 4.2+): bpy.ops.extensions.package_install_files
   into the "user_default" repository. Skipped in Blenders without extensions.
-- The legacy add-on zip: bpy.ops.preferences.addon_install, in every Blender.
+- the add-on installer (Preferences > Add-ons > Install), in every Blender:
+  bpy.ops.preferences.addon_install.
+Either leaves one folder, radiosity/, in the user folder's add-ons or extensions
+and nothing loose (the files of an extension laid out at the zip's top went loose
+into 3.x's scripts/addons/, with no add-on to enable).
 """
 
 import json
@@ -38,15 +44,27 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 HERE = pathlib.Path(__file__).resolve().parent
 
 
-def package_zip(kind):
-    """The zip of `kind` ("extension" or "legacy") in the build folder."""
+def package_zip():
+    """The zip in the build folder."""
     import tomllib
     manifest = tomllib.loads((BUILD / "addon" / "radiosity" / "blender_manifest.toml").read_text())
-    stem = "%s-%s-%s" % (manifest["id"], manifest["version"], "legacy_" if kind == "legacy" else "")
-    path = BUILD / ("%s%s.zip" % (stem, "_".join(manifest["platforms"]).replace("-", "_")))
+    path = BUILD / ("%s-%s-%s.zip" % (manifest["id"], manifest["version"],
+                                      "_".join(manifest["platforms"]).replace("-", "_")))
     if not path.exists():
         raise AssertionError("%s not found: run `make package` (make test does)" % path)
     return path
+
+
+def installed_entries(user):
+    """What the installers put into the user folder's add-ons and extensions folders:
+    their entries (but __pycache__ and the extension repository's own records)."""
+    found = []
+    for folder in ("scripts/addons", "extensions/user_default"):
+        path = pathlib.Path(user) / folder
+        if path.is_dir():
+            found += ["%s/%s" % (folder, p.name) for p in sorted(path.iterdir())
+                      if p.name != "__pycache__" and not p.name.startswith(".")]
+    return found
 
 
 def has_extensions():
@@ -63,7 +81,7 @@ class InstalledPackageTest(unittest.TestCase):
             os.mkdir(images)
             cmd = [bpy.app.binary_path, "-b", "--factory-startup", "--python-exit-code", "1",
                    "--python", str(HERE / "install_and_solve.py"), "--",
-                   kind, str(package_zip(kind)), str(ROOT / "scenes"), str(test_cycles.QUALITY),
+                   kind, str(package_zip()), str(ROOT / "scenes"), str(test_cycles.QUALITY),
                    str(test_cycles.REFERENCE_SAMPLES), images]
             proc = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600,
                                   stdin=subprocess.DEVNULL)
@@ -73,6 +91,7 @@ class InstalledPackageTest(unittest.TestCase):
             self.assertTrue(lines, log)
             report = json.loads(lines[-1][len("RESULT "):])
             report["user"] = os.path.realpath(user)
+            report["installed"] = installed_entries(user)
             report["solution"], report["reference"] = (np.load(os.path.join(images, name + ".npy"))
                                                        for name in ("solution", "reference"))
             return report
@@ -97,14 +116,18 @@ class InstalledPackageTest(unittest.TestCase):
         self.assertLess(region_error, test_cycles.REGION_TOLERANCE)
 
     @unittest.skipUnless(has_extensions(), "this Blender has no extensions (4.2+)")
-    def test_extension_zip(self):
+    def test_zip_through_the_extension_installer(self):
         report = self.install_and_solve("extension")
         self.assertTrue(report["module"].startswith("bl_ext.user_default."), report["module"])
+        self.assertEqual(report["installed"], ["extensions/user_default/radiosity"])
         self.check(report)
 
-    def test_legacy_zip(self):
+    def test_zip_through_the_addon_installer(self):
+        # The same zip through the add-on installer, as in 3.x (and 4.2+'s
+        # Add-ons > Install from Disk).
         report = self.install_and_solve("legacy")
         self.assertEqual(report["module"], "radiosity")
+        self.assertEqual(report["installed"], ["scripts/addons/radiosity"])
         self.check(report)
 
 

@@ -1,6 +1,6 @@
 """The packaged module's dependencies (`make package`, tools/package.py), checked as
 auditwheel checks a wheel for the manylinux_2_28 policy: with readelf, objdump and
-ldd on the files inside the extension zip.
+ldd on the files inside the zip.
 
 - Every shared object in the package needs only libraries inside the package or
   in the allowed system set (glibc's libraries, libstdc++, libgcc_s, libm, the
@@ -47,7 +47,7 @@ ALLOWED = {"libc.so.6", "libm.so.6", "libdl.so.2", "librt.so.1", "libpthread.so.
 MANYLINUX_2_28 = {"GLIBC": (2, 28), "GLIBCXX": (3, 4, 24), "CXXABI": (1, 3, 11), "GCC": (7, 0, 0)}
 
 
-def extension_zip():
+def package_zip():
     manifest = tomllib.loads((ADDON / "blender_manifest.toml").read_text())
     path = BUILD / ("%s-%s-%s.zip" % (manifest["id"], manifest["version"],
                                        "_".join(manifest["platforms"]).replace("-", "_")))
@@ -106,9 +106,10 @@ class PackagedModuleTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory(prefix="radiosity-package-")
-        cls.root = Path(cls.tmp.name).resolve()
-        with zipfile.ZipFile(extension_zip()) as zf:
-            zf.extractall(cls.root)
+        with zipfile.ZipFile(package_zip()) as zf:
+            cls.names = zf.namelist()
+            zf.extractall(cls.tmp.name)
+        cls.root = Path(cls.tmp.name).resolve() / "radiosity"  # the zip's one folder (tools/package.py)
         cls.elves = sorted(p for p in cls.root.rglob("*") if p.is_file() and is_elf(p))
         for path in cls.elves:   # zipfile drops the mode bits of what it extracts
             path.chmod(0o755)
@@ -116,6 +117,16 @@ class PackagedModuleTest(unittest.TestCase):
     @classmethod
     def tearDownClass(cls):
         cls.tmp.cleanup()
+
+    def test_one_folder_for_every_blender(self):
+        # One top-level folder with bl_info's __init__.py and the manifest: Blender
+        # 3.x's add-on installer makes it the add-on radiosity (files at the zip's
+        # top went loose into scripts/addons/), 4.2+'s extension installer finds
+        # the manifest in it (test_package.py in tests/blender installs it in both).
+        self.assertEqual({n.split("/")[0] for n in self.names}, {"radiosity"}, self.names)
+        self.assertIn("radiosity/__init__.py", self.names)
+        self.assertIn("radiosity/blender_manifest.toml", self.names)
+        self.assertIn("bl_info", (self.root / "__init__.py").read_text())
 
     def test_package_has_the_module_and_its_libraries(self):
         names = sorted(p.relative_to(self.root).as_posix() for p in self.elves)

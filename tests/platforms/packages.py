@@ -37,8 +37,8 @@ def manifest():
     return tomllib.loads((ADDON / package.MANIFEST).read_text())
 
 
-def zip_path(platform, kind):
-    path = BUILD / package.zip_name(manifest(), platform, kind)
+def zip_path(platform):
+    path = BUILD / package.zip_name(manifest(), platform)
     if not path.exists():
         raise AssertionError("%s not found: run `make test-platforms` (it builds the %s modules and "
                              "runs `make package`)" % (path, platform))
@@ -46,15 +46,15 @@ def zip_path(platform, kind):
 
 
 class UnpackedZip(unittest.TestCase):
-    """Unpacks PLATFORM's extension zip into self.root, a folder radiosity/ (once per class)."""
+    """Unpacks PLATFORM's zip, whose one folder radiosity/ becomes self.root (once per class)."""
     PLATFORM = None
 
     @classmethod
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory(prefix="radiosity-%s-" % cls.PLATFORM)
-        cls.root = Path(cls.tmp.name).resolve() / "radiosity"   # the package's folder, as Blender names it
-        with zipfile.ZipFile(zip_path(cls.PLATFORM, "extension")) as zf:
-            zf.extractall(cls.root)
+        with zipfile.ZipFile(zip_path(cls.PLATFORM)) as zf:
+            zf.extractall(cls.tmp.name)
+        cls.root = Path(cls.tmp.name).resolve() / "radiosity"   # the zip's one folder (tools/package.py)
         cls.modules = {minor: cls.root / ("_radiosity" + cross_build.suffix(cls.PLATFORM, minor))
                        for minor in cpython.VERSIONS}
 
@@ -64,19 +64,19 @@ class UnpackedZip(unittest.TestCase):
 
 
 class PackageChecks:
-    """What every platform's two zips are checked for (mixed into an UnpackedZip)."""
+    """What every platform's zip is checked for (mixed into an UnpackedZip)."""
 
     def test_zips_hold_the_addon_and_one_module_per_python(self):
         python_files = sorted(p.name for p in ADDON.glob("*.py"))
-        for kind, prefix in (("extension", ""), ("legacy", "radiosity/")):
-            with zipfile.ZipFile(zip_path(self.PLATFORM, kind)) as zf:
-                names = zf.namelist()
-            binaries = sorted(n[len(prefix):] for n in names if "_radiosity." in n)
-            self.assertEqual(binaries, sorted(p.name for p in self.modules.values()), kind)
-            self.assertFalse([n for n in names if "linux-gnu" in n or n.startswith(prefix + "libs/")], names)
-            self.assertTrue(all(n.startswith(prefix) for n in names), names)
-            self.assertLessEqual(set(prefix + p for p in python_files), set(names), kind)
-            self.assertEqual(prefix + package.MANIFEST in names, kind == "extension", kind)
+        prefix = package.FOLDER  # one folder: the add-on in 3.x, the extension in 4.2+
+        with zipfile.ZipFile(zip_path(self.PLATFORM)) as zf:
+            names = zf.namelist()
+        binaries = sorted(n[len(prefix):] for n in names if "_radiosity." in n)
+        self.assertEqual(binaries, sorted(p.name for p in self.modules.values()))
+        self.assertFalse([n for n in names if "linux-gnu" in n or n.startswith(prefix + "libs/")], names)
+        self.assertTrue(all(n.startswith(prefix) for n in names), names)
+        self.assertLessEqual(set(prefix + p for p in python_files), set(names))
+        self.assertIn(prefix + package.MANIFEST, names)
         print("[package] %s: %s" % (self.PLATFORM, ", ".join(
             "%s (%.1f MB)" % (p.name, p.stat().st_size / 1e6) for p in self.modules.values())), flush=True)
 

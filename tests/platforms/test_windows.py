@@ -1,7 +1,7 @@
 """The Windows zips (`make test-platforms`: tools/cross_build.py's modules, tools/package.py),
 checked here and run for real under Wine (tools/wine.py).
 
-- Each module of the extension zip, one per CPython version, read as a PE file
+- Each module of the zip, one per CPython version, read as a PE file
   (`objdump -p`): x86-64, the one export PyInit__radiosity, and imports from
   nothing but that version's python3XY.dll, KERNEL32.dll and the Universal CRT
   (api-ms-win-crt-*.dll, part of every Windows 10): libc++, Embree and oneTBB are
@@ -19,7 +19,8 @@ checked here and run for real under Wine (tools/wine.py).
   another: tools/wine_site/sitecustomize.py supplies the first and turns WMI off,
   so 3.13's suite runs too.
 - PyPI's Blender 4.5 LTS for Windows (bpy 4.5.15, win_amd64) under Wine installs the
-  extension zip and the legacy zip into an empty user folder, enables the add-on,
+  zip into an empty user folder, through the extension installer and through the
+  add-on installer (as 3.x would), enables the add-on,
   solves the bundled cube scene, bakes it and renders it beside a Cycles path trace
   (tests/blender/install_and_solve.py, as tests/blender/test_package.py does in
   Linux Blenders), within test_cycles.py's tolerances.
@@ -223,7 +224,7 @@ class WineBlenderTest(unittest.TestCase):
                    "BLENDER_USER_SCRIPTS": wine.windows_path(user / "scripts"),
                    "BLENDER_USER_CONFIG": wine.windows_path(user / "config")}
             report = self.bpy(["-c", RUN_AFTER_BPY, str(ROOT / "tests" / "blender" / "install_and_solve.py"), "--", kind,
-                               str(zip_path("windows-x64", kind)), str(ROOT / "scenes"), str(agreement["QUALITY"]),
+                               str(zip_path("windows-x64")), str(ROOT / "scenes"), str(agreement["QUALITY"]),
                                str(agreement["REFERENCE_SAMPLES"]), str(images)], cwd=user, env=env)
             mean, region = self.bpy(["-c", COMPARE, str(ROOT / "tests" / "blender"), str(images / "solution.npy"),
                                      str(images / "reference.npy")], cwd=user)
@@ -240,11 +241,11 @@ class WineBlenderTest(unittest.TestCase):
             self.assertLess(region, agreement["REGION_TOLERANCE"])
             return report
 
-    def test_extension_zip(self):
+    def test_zip_through_the_extension_installer(self):
         report = self.install_and_solve("extension")
         self.assertTrue(report["module"].startswith("bl_ext.user_default."), report["module"])
 
-    def test_legacy_zip(self):
+    def test_zip_through_the_addon_installer(self):
         report = self.install_and_solve("legacy")
         self.assertEqual(report["module"], "radiosity")
 
