@@ -6,10 +6,11 @@ invoke, from the UI, runs the same solve on a worker thread with a progress
 bar, status text and ESC to cancel (the solver then returns its last complete
 pass, which is baked). The window stays usable meanwhile: the modal handler
 passes every event on but Esc and the keys of what must wait for the solve
-(LOCKED_OPERATORS); an undo from a menu stops the solve. Both paths run the steps of pipeline.py: `prepare`
-(export, on the main thread), the native solve, and `conclude` (bake, on the
-main thread): bpy is never touched from the worker. Every failure becomes a
-report and {'CANCELLED'}, never a traceback, and leaves the scene as it was.
+(LOCKED_OPERATORS); an undo from a menu stops the solve. Both paths run the
+steps of pipeline.py: `prepare` (export, on the main thread), the native solve,
+and `conclude` (bake, on the main thread): bpy is never touched from the
+worker. Every failure becomes a report and {'CANCELLED'}, never a traceback,
+and leaves the scene as it was.
 
 `radiosity.toggle_result` switches between the solution and the originals;
 `radiosity.clear` removes the solution and restores the originals
@@ -186,6 +187,7 @@ class RADIOSITY_OT_solve(Operator):
         self._status, self._status_time = "", 0.0  # the status text shown, and when
         self._token = solver.CancelToken()
         self._locked_keys = locked_keys(context.window_manager.keyconfigs.user)
+        self._waiting_said = False  # the status says the bake waits for Object Mode
         self._thread = threading.Thread(target=pipeline.work, args=(solver, job, self._token),
                                         name="radiosity-solve", daemon=True)
         wm = context.window_manager
@@ -207,8 +209,14 @@ class RADIOSITY_OT_solve(Operator):
         if event.type == 'TIMER':
             alive = self._thread.is_alive()
             self._poll(context)
-            # The bake waits for Object Mode (a mode switched from a menu).
-            if alive or context.mode != 'OBJECT':
+            if alive:
+                return {'PASS_THROUGH'}
+            if context.mode != 'OBJECT':
+                # The bake waits for Object Mode (a mode switched from a menu).
+                if not self._waiting_said:
+                    self._waiting_said = True
+                    context.workspace.status_text_set("Radiosity: solved; the result is baked "
+                                                      "once you are back in Object Mode")
                 return {'PASS_THROUGH'}
             self._stop_modal(context)
             return self._conclude(context, self._job, self._live)

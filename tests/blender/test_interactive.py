@@ -88,7 +88,7 @@ class InteractiveSolveTest(unittest.TestCase):
         self.assertIsNotNone(clicks, r)
         material = [seen for seen in clicks["shading"] if seen[0] == 'MATERIAL']
         self.assertTrue(material, clicks)
-        shading, running, polygons, quality, _ = material[0]
+        shading, running, polygons, quality, in_pass = material[0]
         self.assertTrue(running, clicks)  # changed while the solve ran
         self.assertGreater(polygons, 0, clicks)  # the pass shown stayed: no undo
         self.assertAlmostEqual(quality, 1.0, places=6, msg=clicks)
@@ -96,8 +96,8 @@ class InteractiveSolveTest(unittest.TestCase):
         self.assertTrue(r["valid"], r)
         self.assertEqual(r["status"], "Cancelled (last complete pass kept)")
         self.assertGreater(r["final_polygons"], 0)
-        print("clicks during the solve: shading %s, Esc kept %d elements"
-              % ([seen[0] for seen in clicks["shading"]], r["elements"]))
+        print("clicks during the solve: shading %s, Material Preview read during pass %s, Esc kept %d elements"
+              % ([seen[0] for seen in clicks["shading"]], in_pass, r["elements"]))
 
     def test_two_sided_faces_do_not_speckle(self):
         # Each side of a two-sided face is its own polygon, a hair in front of
