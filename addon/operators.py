@@ -65,7 +65,7 @@ LOCKED_OPERATORS = {
 }
 LOCKED_MENUS = {"VIEW3D_MT_object_mode_pie": "Mode switching"}
 # What undoing through a menu (which no key passes) does to a running solve.
-UNDONE = "Undo during the radiosity solve stopped it: the scene is as the undo left it"
+UNDONE = "Undo during the radiosity solve stopped it: the scene is as before the solve"
 
 
 def _modifier_matches(wanted, pressed, any_modifier):
@@ -228,12 +228,22 @@ class RADIOSITY_OT_solve(Operator):
         return {'PASS_THROUGH'}  # the rest of the interface works as ever
 
     def _drop_undone(self, context):
-        """An undo replaced the scene: stop the solver and leave the scene as the
-        undo made it (what the passes showed is gone or was the undo's)."""
+        """An undo replaced the scene: stop the solver and put the scene back as
+        it was before the solve. Blender's undo keeps the objects it finds
+        unchanged since its last step, and the passes' changes made no step: the
+        originals the passes hid would stay hidden, with no result to show."""
         self._token.cancel()
         self._thread.join()
         self._stop_modal(context)
-        self._live = None
+        if self._live is not None:
+            try:
+                self._live.abort()
+            except ReferenceError:
+                # The undo read the scene anew (the transaction's scene is gone): the
+                # originals come back by their tags.
+                result_state.restore_originals(context.scene, context.view_layer)
+            self._live = None
+        result_state.sync_views(context.scene)
         self.report({'WARNING'}, UNDONE)
         return {'CANCELLED'}
 

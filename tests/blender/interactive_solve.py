@@ -1,7 +1,9 @@
 """Blender side of test_interactive.py: the interactive solve in a real window.
 
     xvfb-run blender --factory-startup FILE.blend \
-        --python interactive_solve.py -- ADDON_DIR run|cancel|cancel_after:SECONDS|clicks [SHOTS_DIR]
+        --python interactive_solve.py -- ADDON_DIR MODE [SHOTS_DIR]
+
+MODE: run, cancel, cancel_after:SECONDS, clicks, menu_undo or edit_mode.
 
 Once the window is idle (its first draws compile shaders, seconds of CPU under
 software OpenGL), invokes radiosity.solve with INVOKE_DEFAULT in the 3D view
@@ -14,7 +16,11 @@ the elements refined 2, 4 and 6 s after the click. "clicks": once a pass is
 shown, real events on the X display as a user would send them: Ctrl+Z (which
 must wait: the solve's undo lock), then Z's pie menu in the 3D view and a click
 on its Material Preview; when the view's shading reads Material Preview while
-the solve still runs, Esc. With SHOTS_DIR it writes
+the solve still runs, Esc. "menu_undo": once a pass is shown, Edit > Undo's
+operator run as its menu item runs it (no key: keys of Undo wait). "edit_mode":
+an object the solve leaves out (disabled in renders) goes into Edit Mode right
+after the click, as the header's mode menu would, and back to Object Mode once
+the solver has finished. With SHOTS_DIR it writes
 SHOTS_DIR/solve_in_progress.png, the window when the first pass is shown
 (the Properties editor scrolled to the Radiosity panel).
 
@@ -93,13 +99,24 @@ def start():
     win = window()
     area = view_3d()
     bpy.context.scene.radiosity.quality = 1.0 if MODE.startswith("cancel") or MODE == "clicks" else 0.5
-    if MODE == "clicks":
+    if MODE == "edit_mode":
+        mesh = bpy.data.meshes.new("Edited")
+        mesh.from_pydata([(0, 0, 5), (1, 0, 5), (1, 1, 5)], [], [(0, 1, 2)])
+        edited = bpy.data.objects.new("Edited", mesh)
+        edited.hide_render = True  # left out of the solve, so it stays shown and editable
+        bpy.context.scene.collection.objects.link(edited)
+        bpy.context.view_layer.objects.active = edited
+    if MODE in ("clicks", "menu_undo"):
         # An undo step to go back to (the file as loaded has none): Ctrl+Z, if it
         # were not locked, would take the scene back to quality 0.5, without the pass.
         bpy.ops.ed.undo_push(message="Radiosity quality 1")
     with bpy.context.temp_override(window=win, area=area):
         state["invoke"] = sorted(bpy.ops.radiosity.solve('INVOKE_DEFAULT'))
     state["start"] = time.time()
+    if MODE == "edit_mode":
+        # Before the operator's first timer tick: whatever the machine's speed, the
+        # whole solve runs with an object in Edit Mode.
+        state["edit_mode"] = {"enter": in_view_3d(bpy.ops.object.mode_set, mode='EDIT'), "mode": bpy.context.mode}
 
 
 def first_pass_done():
@@ -120,6 +137,7 @@ def watch():
         return 0.05
     progress = operators.running_progress()
     if progress is None and state["ticks"] > 0:
+        state["ended"] = True
         return None  # the solve has ended
     if progress is not None:
         state["ticks"] += 1
@@ -171,6 +189,35 @@ def watch_shading():
     return 0.05
 
 
+def in_view_3d(operator, **kwargs):
+    # An operator as a menu item in the 3D view runs it.
+    win = window()
+    with bpy.context.temp_override(window=win, screen=win.screen, area=view_3d()):
+        return sorted(operator(**kwargs))
+
+
+def undo_from_menu():
+    if state["start"] is None or not state["mesh_states"]:
+        return 0.05
+    state["menu_undo"] = {"running_before": operators.running_progress() is not None,
+                          "undo": in_view_3d(bpy.ops.ed.undo)}
+    return None
+
+
+def edit_mode():
+    # Back to Object Mode once the solver has finished (start() went into Edit
+    # Mode), noting whether the result waited (no statistics, no pass shown yet).
+    if "edit_mode" not in state:
+        return 0.05
+    job = operators._running_job
+    if job is not None and job.result is None and job.error is None:
+        return 0.05  # the solver still runs
+    state["edit_mode"].update(finished_running=job is not None, valid_before=bpy.context.scene.radiosity.stats.valid,
+                              polygons_before=result_polygons())
+    state["edit_mode"]["leave"] = in_view_3d(bpy.ops.object.mode_set, mode='OBJECT')
+    return None
+
+
 def press_escape():
     # A real key press on the X display (XTEST), into the window under the pointer.
     win = window()
@@ -201,7 +248,7 @@ def check():
     if state["start"] is None:
         return 0.2
     stats = bpy.context.scene.radiosity.stats
-    if not stats.valid and time.time() - state["start"] < 120:
+    if not stats.valid and not state.get("ended") and time.time() - state["start"] < 120:
         return 0.2
     results = [o for o in bpy.context.scene.objects if o.get("radiosity_result")]
     shading = [s.shading.color_type for a in window().screen.areas for s in a.spaces if s.type == 'VIEW_3D']
@@ -217,6 +264,9 @@ def check():
         "final_polygons": result_polygons(), "escaped_at": state.get("escaped_at"),
         "leaves_after": state["leaves_after"], "idle_after": state.get("idle_after"),
         "screenshot_at": state.get("screenshot_at"), "clicks": state["clicks"],
+        "originals_shown": sorted({(not o.hide_render and not o.hide_get()) for o in bpy.context.scene.objects
+                                   if o.type == 'MESH' and not o.get("radiosity_result")}),
+        "menu_undo": state.get("menu_undo"), "edit_mode": state.get("edit_mode"), "mode": bpy.context.mode,
     }), flush=True)
     bpy.ops.wm.quit_blender()
     return None
@@ -247,6 +297,10 @@ if MODE == "cancel":
     bpy.app.timers.register(escape, first_interval=0.6)
 elif MODE == "clicks":
     bpy.app.timers.register(send_clicks, first_interval=0.6)
+elif MODE == "menu_undo":
+    bpy.app.timers.register(undo_from_menu, first_interval=0.6)
+elif MODE == "edit_mode":
+    bpy.app.timers.register(edit_mode, first_interval=0.6)
 elif MODE.startswith("cancel_after:"):
     bpy.app.timers.register(escape_after(float(MODE.split(":")[1])), first_interval=0.52)
 bpy.app.timers.register(check, first_interval=0.7)

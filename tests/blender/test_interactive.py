@@ -99,6 +99,36 @@ class InteractiveSolveTest(unittest.TestCase):
         print("clicks during the solve: shading %s, Material Preview read during pass %s, Esc kept %d elements"
               % ([seen[0] for seen in clicks["shading"]], in_pass, r["elements"]))
 
+    def test_undo_from_the_menu_stops_the_solve(self):
+        # Undo's keys wait while a solve runs, but Edit > Undo's menu item runs
+        # ed.undo all the same: once a pass is shown, the solve stops and the scene
+        # is as before it (the undo step made just before the solve, at quality
+        # 0.5): no result, no statistics, the originals shown again (Blender's undo
+        # left them hidden as the pass had, and without a result).
+        r = self.run_window("full_office", "menu_undo")
+        self.assertEqual(r["menu_undo"], {"running_before": True, "undo": ["FINISHED"]}, r)
+        self.assertEqual(r["quality"], 0.5)
+        self.assertFalse(r["valid"], r)
+        self.assertEqual((r["results"], r["final_polygons"]), (0, 0), r)
+        self.assertEqual(r["originals_shown"], [True], r)
+        self.assertEqual(r["mode"], 'OBJECT')
+
+    def test_the_bake_waits_for_object_mode(self):
+        # An object the solve leaves out goes into Edit Mode once a pass is shown (as
+        # the header's mode menu does it; Tab's key waits): the finished solve is
+        # baked only once Object Mode is back.
+        r = self.run_window("full_office", "edit_mode")
+        edit = r["edit_mode"]
+        self.assertIsNotNone(edit, r)
+        self.assertEqual((edit["enter"], edit["mode"]), (["FINISHED"], 'EDIT_MESH'), edit)
+        self.assertTrue(edit["finished_running"], edit)  # the solver done, the operator still waiting
+        self.assertFalse(edit["valid_before"], edit)
+        self.assertEqual(edit["leave"], ["FINISHED"], edit)
+        self.assertTrue(r["valid"], r)
+        self.assertEqual(r["status"], "Converged")
+        self.assertGreater(r["final_polygons"], 0)
+        self.assertEqual(r["mode"], 'OBJECT')
+
     def test_two_sided_faces_do_not_speckle(self):
         # Each side of a two-sided face is its own polygon, a hair in front of
         # the other: in Solid view the two fight for the depth buffer and closed
