@@ -26,7 +26,7 @@ import bpy
 from bpy.app.handlers import persistent
 from bpy.types import Operator
 
-from . import bake, live_pacing, native, pipeline, result_state, solve_reuse
+from . import bake, live_pacing, native, pipeline, result_state, solve_reuse, view_sync
 from .progress_text import status_line
 
 # The interactive solve in progress (at most one: the operator is modal), so
@@ -109,15 +109,11 @@ UNDO_HANDLERS = (bpy.app.handlers.undo_post, bpy.app.handlers.redo_post)
 
 
 def register():
-    for handlers in UNDO_HANDLERS:
-        if _undone not in handlers:
-            handlers.append(_undone)
+    view_sync.attach(_undone, UNDO_HANDLERS)
 
 
 def unregister():
-    for handlers in UNDO_HANDLERS:
-        if _undone in handlers:
-            handlers.remove(_undone)
+    view_sync.detach(_undone, UNDO_HANDLERS)
 
 
 def pass_printer():

@@ -24,13 +24,22 @@ def _sync(*_args):
 HANDLERS = (bpy.app.handlers.undo_post, bpy.app.handlers.redo_post, bpy.app.handlers.load_post)
 
 
+def attach(function, handler_lists):
+    """Adds `function` to each of bpy.app.handlers' `handler_lists` once."""
+    for handlers in handler_lists:
+        if function not in handlers:
+            handlers.append(function)
+
+
+def detach(function, handler_lists):
+    for handlers in handler_lists:
+        if function in handlers:
+            handlers.remove(function)
+
+
 def register():
-    for handlers in HANDLERS:
-        if _sync not in handlers:
-            handlers.append(_sync)
+    attach(_sync, HANDLERS)
 
 
 def unregister():
-    for handlers in HANDLERS:
-        if _sync in handlers:
-            handlers.remove(_sync)
+    detach(_sync, HANDLERS)
