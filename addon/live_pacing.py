@@ -22,9 +22,10 @@ DISPLAY_SHARE = 0.15
 class LivePacing:
     """Decides when the next pass may be shown; measures what showing costs."""
 
-    def __init__(self, share=DISPLAY_SHARE):
+    def __init__(self, share=DISPLAY_SHARE, clock=time.perf_counter):
         self.share = share
-        self.shown_at = None  # perf_counter when the last pass was shown
+        self.clock = clock  # seconds; the draws are timed on it
+        self.shown_at = None  # the clock when the last pass was shown
         self.cost = 0.0  # seconds its bake and the draws since took
         self._draw_started = None
         self._handlers = [
@@ -33,22 +34,22 @@ class LivePacing:
         ]
 
     def draw_begins(self):
-        self._draw_started = time.perf_counter()
+        self._draw_started = self.clock()
 
     def draw_ends(self):
         if self._draw_started is not None and self.shown_at is not None:
-            self.cost += time.perf_counter() - self._draw_started
+            self.cost += self.clock() - self._draw_started
         self._draw_started = None
 
     def may_show(self, now=None):
         """Whether a pass may be shown now: the first always may."""
         if self.shown_at is None:
             return True
-        now = time.perf_counter() if now is None else now
+        now = self.clock() if now is None else now
         return self.cost <= self.share * (now - self.shown_at)
 
     def shown(self, began, ended):
-        """A pass was baked from `began` to `ended` (perf_counter); its draws follow."""
+        """A pass was baked from `began` to `ended` (on the clock); its draws follow."""
         self.shown_at = began
         self.cost = ended - began
 

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <atomic>
 #include <exception>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -323,7 +324,8 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
                   const py::object& threads, const py::object& progress, const py::object& cancel,
                   double min_element_area, const std::string& leaf_links,
                   std::optional<double> cluster_separation, const py::object& memory_limit,
-                  bool pass_results, bool yield_to_interface, const py::object& reuse) {
+                  bool pass_results, bool yield_to_interface, const py::object& reuse,
+                  const py::object& clock) {
   SolveOptions options;
   options.oracle = read_oracle(oracle);
   options.quality = quality;
@@ -392,6 +394,24 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
         callback_error = std::current_exception();
         callback_failed = true;
       }
+    };
+  }
+  if (!clock.is_none()) {
+    if (!PyCallable_Check(clock.ptr()))
+      throw std::invalid_argument("clock must be callable or None");
+    // Read from the solve's threads; a failing clock stops the solve like a
+    // failing callback (its time then reads as past any budget).
+    options.clock = [&]() -> double {
+      py::gil_scoped_acquire gil;
+      if (!callback_error) {
+        try {
+          return py::cast<double>(clock());
+        } catch (...) {
+          callback_error = std::current_exception();
+          callback_failed = true;
+        }
+      }
+      return std::numeric_limits<double>::infinity();
     };
   }
   const CancelCheck cancelled = [&] {
@@ -605,7 +625,7 @@ void bind_solver(py::module_& m) {
         py::arg("leaf_links") = std::string(leaf_links_name(defaults.leaf_links)),
         py::arg("cluster_separation") = py::none(), py::arg("memory_limit") = py::none(),
         py::arg("pass_results") = false, py::arg("yield_to_interface") = false,
-        py::arg("reuse") = py::none(),
+        py::arg("reuse") = py::none(), py::arg("clock") = py::none(),
         "Hierarchical radiosity. oracle: 'standard' | 'perceptual' | 'gradient' |\n"
         "'noticeable'; quality in\n"
         "[0, 1] (0: no refinement); max_elements, time_budget (s): budgets; visibility:\n"
@@ -623,7 +643,9 @@ void bind_solver(py::module_& m) {
         "(never decreasing); with pass_results, the 'pass' reports carry 'result': that pass's\n"
         "solution, as solve() returns it. yield_to_interface: the solve's threads run at a lower\n"
         "CPU priority than the process's others (a UI beside the solve). reuse: a SolveReuse;\n"
-        "the solve relights the one it keeps when only the lighting changed (stats['reused']).");
+        "the solve relights the one it keeps when only the lighting changed (stats['reused']).\n"
+        "clock: a callable giving seconds from any origin, read instead of the steady clock for\n"
+        "time_budget and the reported seconds (tests' fake clock).");
   m.def(
       "quality_threshold",
       [](const std::string& oracle, double quality) {

@@ -2,7 +2,6 @@
 once the last one's bake and redraws cost at most the display's share of the
 time since; the 3D views' draw handlers it adds are removed again."""
 
-import time
 import unittest
 
 import bpy
@@ -12,7 +11,8 @@ from radiosity import live_pacing
 
 class LivePacingTest(unittest.TestCase):
     def setUp(self):
-        self.pacing = live_pacing.LivePacing(share=0.2)
+        self.now = 100.0  # the pacer's clock, moved by the tests
+        self.pacing = live_pacing.LivePacing(share=0.2, clock=lambda: self.now)
         self.addCleanup(self.pacing.close)
 
     def test_the_first_pass_is_always_shown(self):
@@ -24,15 +24,18 @@ class LivePacingTest(unittest.TestCase):
         self.assertTrue(self.pacing.may_show(now=10.55))  # 0.1 s of 0.55 s: 18 %
 
     def test_redraws_after_a_pass_count_in_its_cost(self):
-        began = time.perf_counter()
-        self.pacing.shown(began=began, ended=began)
+        self.pacing.shown(began=self.now, ended=self.now)
         for _ in range(3):  # as Blender calls the handlers around each redraw
             self.pacing.draw_begins()
-            time.sleep(0.02)
+            self.now += 0.02
             self.pacing.draw_ends()
-        self.assertGreaterEqual(self.pacing.cost, 0.06)
-        self.assertFalse(self.pacing.may_show(now=began + 0.2))
-        self.assertTrue(self.pacing.may_show(now=began + 5 * self.pacing.cost + 0.01))
+            self.now += 0.01
+        self.assertAlmostEqual(self.pacing.cost, 0.06)
+        self.assertFalse(self.pacing.may_show())  # 0.06 s of 0.09 s
+        self.now += 0.2
+        self.assertFalse(self.pacing.may_show())  # 0.06 s of 0.29 s: 21 %
+        self.now += 0.02
+        self.assertTrue(self.pacing.may_show())  # 0.06 s of 0.31 s: 19 %
 
     def test_draws_before_the_first_pass_cost_nothing(self):
         self.pacing.draw_begins()

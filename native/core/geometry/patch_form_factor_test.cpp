@@ -6,7 +6,6 @@
 #include <gtest/gtest.h>
 
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
@@ -438,12 +437,10 @@ TEST(PatchFormFactor, NeighbourOneTrillionthTheSizeReturns) {
       {-2.5779088494722595e-09, -2.3716603554321239e-11, -2.4121532306303872e-09},
       {-2.5779088494707292e-09, -2.3716603554665055e-11, -2.4121532306298371e-09},
       {-2.5779088494711866e-09, -2.3716603554238178e-11, -2.4121532306282978e-09}};
-  const auto start = std::chrono::steady_clock::now();
+  // Returning at all is the test (a hang fails it at ctest's --timeout; no
+  // wall-clock bound here, which a loaded machine could break).
   const double f = patch_form_factor(quad_p, tiny);
   const double back = patch_form_factor(tiny, quad_p);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  EXPECT_LT(seconds, 5.0);
   EXPECT_TRUE(std::isfinite(f));
   EXPECT_TRUE(std::isfinite(back));
   // What reaches a face 1e-24 of the quad's area is nothing at double precision.

@@ -120,7 +120,9 @@ class Solver {
     if (!stopped_ && cancel_ && *cancel_ && (*cancel_)()) stopped_ = true;
     return stopped_;
   }
-  double elapsed() const { return seconds_since(start_); }
+  double elapsed() const {
+    return options_.clock ? options_.clock() - clock_start_ : seconds_since(start_);
+  }
   bool out_of_time() const { return options_.time_budget && elapsed() > *options_.time_budget; }
   // Cancelled, or a refinement cut short by the time budget: the pass is
   // abandoned and the last complete one stands.
@@ -164,6 +166,7 @@ class Solver {
   const CancelCheck* cancel_ = nullptr;
   mutable std::atomic<bool> stopped_{false};  // read and set from worker threads
   Clock::time_point start_;
+  double clock_start_ = 0.0;  // options_.clock() when the call began
   Hierarchy hierarchy_;
   SceneOccluders occluders_;
   LinkEvaluator evaluator_;
@@ -650,6 +653,7 @@ void Solver::begin(const SolveOptions& options, const ProgressCallback& progress
   cancel_ = &cancel;
   stopped_ = false;
   start_ = Clock::now();
+  clock_start_ = options.clock ? options.clock() : 0.0;
   limits_ = {options.min_element_area * scene_.total_area, options.max_elements};
   memory_limit_ = options.memory_limit.value_or(std::numeric_limits<std::size_t>::max());
   budget_hit_ = memory_hit_ = cut_short_ = refinement_cut_short_ = complete_ = false;

@@ -56,7 +56,11 @@ struct SolveOptions {
   // threshold scale allows; see quality_threshold().
   double quality = 0.5;
   std::optional<std::size_t> max_elements;  // element budget
-  std::optional<double> time_budget;        // seconds
+  std::optional<double> time_budget;        // seconds, on `clock`
+  // Seconds from any fixed origin, read for the time budget and the result's
+  // `seconds`; empty: the steady clock. Tests give a fake one, so that what a
+  // budget stops does not depend on the machine's speed or load.
+  std::function<double()> clock;
   // Bytes the elements and links may hold; refinement stops there (stopped_by
   // "memory"), and a scene whose unrefined solve cannot fit is refused before
   // any allocation. Default: 3/4 of the memory available when the solve starts.
