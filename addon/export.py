@@ -26,7 +26,6 @@ transmission read as diffuse, an emission texture's average) is collected in
 """
 
 import math
-import re
 from dataclasses import dataclass, field
 
 import bpy
@@ -535,45 +534,7 @@ def _unique(used, name):
     return name if count == 1 else "%s.%d" % (name, count)
 
 
-def coincident_message(exported, pairs, most=4):
-    """One warning line naming objects whose faces lie in the same place
-    (z-fighting in a render; the solver counts each such surface once), or ''."""
-    if not pairs:
-        return ""
-    face_part = exported.arrays["face_part"]
-    names = []
-    for a, b in pairs:
-        first, second = exported.parts[face_part[a]].name, exported.parts[face_part[b]].name
-        pair = first if first == second else "%s and %s" % tuple(sorted((first, second)))
-        if pair not in names:
-            names.append(pair)
-    more = " and %d more" % (len(names) - most) if len(names) > most else ""
-    return "faces in the same place, counted once: %s%s" % ("; ".join(names[:most]), more)
-
-
-def face_notes_message(exported, notes, what, most=4):
-    """One warning line for the solver's notes on faces ((face, text) pairs:
-    Scene.skipped_faces or repaired_faces), grouped by object and reason, or ''."""
-    if not notes:
-        return ""
-    face_part = exported.arrays["face_part"]
-    groups = {}
-    for face, text in notes:
-        # "bends by 3.2 % of its size" differs per face: group on what was done.
-        reason = re.sub(r" \(bends by [^)]*\)", "", text)
-        reason = re.sub(r"too small to solve \(.*\)", "too small to solve", reason)
-        groups.setdefault((exported.parts[face_part[face]].name, reason), []).append(text)
-    lines = []
-    for (name, reason), texts in groups.items():
-        bends = [float(b) for t in texts for b in re.findall(r"bends by ([0-9.e+-]+) %", t)]
-        detail = " (most: %.3g %%)" % max(bends) if len(bends) > 1 else (" (%.3g %%)" % bends[0] if bends else "")
-        lines.append("%s: %d face%s %s%s" % (name, len(texts), "s" if len(texts) > 1 else "", reason, detail))
-    more = " and %d more" % (len(lines) - most) if len(lines) > most else ""
-    return "%s %s%s" % (what, "; ".join(lines[:most]), more)
-
-
-def unmodelled_message(unmodelled):
-    """One warning line for what the solve ignores, or ''."""
-    if not unmodelled:
-        return ""
-    return "Not modelled: " + "; ".join(unmodelled)
+def face_object(exported):
+    """face -> the name of the object input face `face` came from."""
+    face_part, parts = exported.arrays["face_part"], exported.parts
+    return lambda face: parts[face_part[face]].name

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import bake, export, game_export, result_state, scene_transaction, solve_reuse
+from . import bake, export, findings, game_export, result_state, scene_transaction, solve_reuse
 
 STATUS = {
     "quality": "Converged",
@@ -24,10 +24,6 @@ STATUS = {
     "time_budget": "Time budget reached",
     "cancel": "Cancelled (last complete pass kept)",
 }
-
-
-# The native refusal when no solve of the scene was kept yet.
-NOTHING_KEPT = "no solve is kept"
 
 
 class SolveError(Exception):
@@ -137,7 +133,7 @@ def prepare(context, solver, started=None):
     with result_state.OriginalsShown(scene, context.view_layer), export.rendered_shown(context.view_layer):
         exported = export.export_scene(context)
     arrays = exported.arrays
-    note = "; ".join(exported.repaired + ([export.unmodelled_message(exported.unmodelled)]
+    note = "; ".join(exported.repaired + ([findings.unmodelled_message(exported.unmodelled)]
                                           if exported.unmodelled else []))
     if exported.face_count == 0:
         raise SolveError("Nothing to solve: the scene has no visible mesh objects or area lights"
@@ -304,18 +300,14 @@ def record(context, job, stats, skipped_objects, warnings):
     """The warnings and statistics of a finished solve into scene.radiosity.stats."""
     settings = context.scene.radiosity
     warnings.extend(job.exported.repaired)
-    note = export.unmodelled_message(job.exported.unmodelled)
-    if note:
-        warnings.append(note)
-    for hint in (rough_look_hint(job.options.get("visibility"), stats), visibility_hint(job.options.get("visibility"), stats)):
-        if hint:
-            warnings.append(hint)
-    coincident = export.coincident_message(job.exported, job.native_scene.coincident_faces)
-    if coincident:
-        warnings.append(coincident)
-    for notes, what in ((job.native_scene.skipped_faces, "faces left out:"),
-                        (job.native_scene.repaired_faces, "faces repaired:")):
-        message = export.face_notes_message(job.exported, notes, what)
+    face_object = export.face_object(job.exported)
+    native_scene = job.native_scene
+    for message in (findings.unmodelled_message(job.exported.unmodelled),
+                    rough_look_hint(job.options.get("visibility"), stats),
+                    visibility_hint(job.options.get("visibility"), stats),
+                    findings.coincident_message(face_object, native_scene.coincident_faces),
+                    findings.face_notes_message(face_object, native_scene.skipped_faces, "faces left out:"),
+                    findings.face_notes_message(face_object, native_scene.repaired_faces, "faces repaired:")):
         if message:
             warnings.append(message)
     for reason in sorted({why for _, why in skipped_objects}):
@@ -331,7 +323,6 @@ def record(context, job, stats, skipped_objects, warnings):
     s.seconds = float(stats.get("seconds", 0.0))
     s.relit = bool(stats.get("reused", False))
     # Why a solve that could have relit linked anew (nothing said the first time).
-    refusal = str(stats.get("reuse_refusal", ""))
-    s.relinked_because = refusal if refusal and refusal != NOTHING_KEPT else ""
+    s.relinked_because = findings.relink_reason(stats.get("reuse_refusal", ""))
     s.warning = "; ".join(warnings)
     return s

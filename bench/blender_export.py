@@ -25,14 +25,14 @@ def main():
     parser.add_argument("--out", required=True)
     args = common.arguments(parser)
     common.enable_addon(args.addon)
-    from radiosity import export
+    from radiosity import export, findings
 
     common.lambertian_scene()
     exported = export.export_scene(bpy.context)
     a = exported.arrays
     np.savez(args.out, positions=a["positions"], face_vertices=a["face_vertices"], face_sizes=a["face_sizes"],
              reflectance=a["reflectance"], emission=a["emission"], two_sided=a["two_sided"])
-    common.say("exported %d faces (%s)" % (exported.face_count, export.unmodelled_message(exported.unmodelled)
+    common.say("exported %d faces (%s)" % (exported.face_count, findings.unmodelled_message(exported.unmodelled)
                                           or "everything modelled"))
 
 

@@ -208,6 +208,28 @@ struct PyResult {
   py::dict stats;
 };
 
+// Scene::skipped or repaired as Python data: the kind by name, and the
+// numbers that kind has.
+py::list face_notes(const std::vector<FaceNote>& notes) {
+  py::list out;
+  for (const FaceNote& n : notes) {
+    py::dict d;
+    d["face"] = n.face;
+    d["kind"] = std::string(face_issue_name(n.issue));
+    if (n.issue == FaceIssue::TooSmall) {
+      d["size"] = n.size;
+      d["scene_size"] = n.scene_size;
+    } else if (n.issue == FaceIssue::RepeatedCorners) {
+      d["corners"] = n.count;
+    } else if (n.issue == FaceIssue::NotPlanar) {
+      d["bend"] = n.bend;
+      d["triangles"] = n.count;
+    }
+    out.append(std::move(d));
+  }
+  return out;
+}
+
 py::dict stats_dict(const SolveStats& s) {
   py::dict d;
   d["elements"] = s.elements;
@@ -223,7 +245,7 @@ py::dict stats_dict(const SolveStats& s) {
   d["repaired_faces"] = s.repaired_faces;
   d["cancelled"] = s.cancelled;
   d["reused"] = s.reused;
-  d["reuse_refusal"] = s.reuse_refusal;
+  d["reuse_refusal"] = std::string(relight_refusal_name(s.reuse_refusal));
   d["stopped_by"] = std::string(stop_reason_name(s.stopped_by));
   d["seconds"] = s.seconds;
   d["seconds_linking"] = s.seconds_linking;
@@ -546,23 +568,16 @@ void bind_solver(py::module_& m) {
           "light_count", [](const Scene& s) { return s.lights.size(); },
           "lights solved as direct light: point, spot and sun lights, and the sky")
       .def_property_readonly(
-          "skipped_faces",
-          [](const Scene& s) {
-            py::list out;
-            for (const auto& k : s.skipped) out.append(py::make_tuple(k.face, k.what));
-            return out;
-          },
-          "(face, reason) of the input faces left out: zero area, or too small to solve")
+          "skipped_faces", [](const Scene& s) { return face_notes(s.skipped); },
+          "the input faces left out, a dict each: face, kind ('coincident_corners',\n"
+          "'collinear_corners', 'crosses_itself', 'no_triangles'; 'too_small' with size and\n"
+          "scene_size, the face's and the scene's diameters)")
       .def_property_readonly(
-          "repaired_faces",
-          [](const Scene& s) {
-            py::list out;
-            for (const auto& k : s.repaired) out.append(py::make_tuple(k.face, k.what));
-            return out;
-          },
-          "(face, what was done) of the input faces solved after a repair: repeated corners "
-          "removed,\n"
-          "non-planar or self-crossing outlines split into triangles")
+          "repaired_faces", [](const Scene& s) { return face_notes(s.repaired); },
+          "the repairs of input faces solved after one, a dict each: face, kind\n"
+          "('repeated_corners' with corners, how many were removed; 'not_planar' with bend,\n"
+          "the corners' largest distance from the face's plane over its diameter, and\n"
+          "triangles, how many planar ones it was split into)")
       .def_property_readonly(
           "coincident_faces",
           [](const Scene& s) {

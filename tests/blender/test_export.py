@@ -14,7 +14,7 @@ import unittest
 import bpy
 import numpy as np
 
-from radiosity import arrays, export, result_state
+from radiosity import arrays, export, findings, result_state
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "scenes")))
 import scene_kit as kit  # noqa: E402
@@ -108,7 +108,7 @@ class MaterialTest(unittest.TestCase):
         np.testing.assert_allclose(face_rows(ex, "M")["emission"], [[0.375, 0.75, 0.75]], rtol=1e-6)
         # Unknown setup: viewport colour, and said so.
         np.testing.assert_allclose(face_rows(ex, "G")["reflectance"], [[0.1, 0.2, 0.3]], rtol=1e-6)
-        self.assertIn("materials G", export.unmodelled_message(ex.unmodelled).replace("material ", "materials "))
+        self.assertIn("materials G", findings.unmodelled_message(ex.unmodelled).replace("material ", "materials "))
         np.testing.assert_allclose(face_rows(ex, "None")["reflectance"], [export.DEFAULT_REFLECTANCE])
         self.assertTrue(np.all(ex.arrays["two_sided"]))
 
@@ -160,7 +160,7 @@ class MaterialTest(unittest.TestCase):
         ex = export_now()
         np.testing.assert_allclose(face_rows(ex, "Metal")["reflectance"], [[0.5, 0.5, 0.5]], rtol=1e-6)
         np.testing.assert_allclose(face_rows(ex, "Screen")["emission"], [[2.0, 1.0, 0.5]], rtol=1e-6)
-        message = export.unmodelled_message(ex.unmodelled)
+        message = findings.unmodelled_message(ex.unmodelled)
         self.assertIn("material Metal (metallic read as diffuse)", message)
         self.assertIn("material Glass (transmission read as diffuse)", message)
         self.assertIn("material Screen (emission texture averaged)", message)
@@ -228,7 +228,7 @@ class LightTest(unittest.TestCase):
         default_tree = bpy.data.lights["POINT"]
         default_tree.use_nodes = True
         self.assertFalse(export.light_nodes_change_it(default_tree))
-        self.assertEqual(export.unmodelled_message(export_now().unmodelled), "")
+        self.assertEqual(findings.unmodelled_message(export_now().unmodelled), "")
         emission = next(n for n in default_tree.node_tree.nodes if n.bl_idname == 'ShaderNodeEmission')
         emission.inputs["Strength"].default_value = 2.0
         self.assertTrue(export.light_nodes_change_it(default_tree))
@@ -245,7 +245,7 @@ class LightTest(unittest.TestCase):
             np.testing.assert_allclose(normal, [[0, 1, 0]], atol=1e-6)   # -z turned to +y (float32 matrix)
         # Point, spot and sun lights are the solver's direct lights, not polygons.
         self.assertEqual(sorted(light["type"] for light in ex.lights), ["point", "point", "spot", "sun"])
-        self.assertEqual(export.unmodelled_message(ex.unmodelled), "Not modelled: light node setups")
+        self.assertEqual(findings.unmodelled_message(ex.unmodelled), "Not modelled: light node setups")
 
 
 if __name__ == "__main__":

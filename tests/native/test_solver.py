@@ -414,7 +414,7 @@ class BadInput(unittest.TestCase):
         scene = rad.Scene(positions, np.concatenate([a["face_vertices"], [n, n + 1, n + 2]]),
                           np.concatenate([a["face_sizes"], [3]]), np.vstack([a["reflectance"], [[.5] * 3]]),
                           np.vstack([a["emission"], [[0] * 3]]))
-        self.assertEqual(scene.skipped_faces, [(6, "zero area (collinear vertices)")])
+        self.assertEqual(scene.skipped_faces, [{"face": 6, "kind": "collinear_corners"}])
         result = rad.solve(scene, quality=0.0)
         self.assertNotIn(6, result.source_face)
 

@@ -262,6 +262,33 @@ void check_values(const SceneArrays& a) {
 
 }  // namespace
 
+std::string_view face_issue_name(FaceIssue issue) {
+  switch (issue) {
+    case FaceIssue::CoincidentCorners:
+      return "coincident_corners";
+    case FaceIssue::CollinearCorners:
+      return "collinear_corners";
+    case FaceIssue::CrossesItself:
+      return "crosses_itself";
+    case FaceIssue::TooSmall:
+      return "too_small";
+    case FaceIssue::NoTriangles:
+      return "no_triangles";
+    case FaceIssue::RepeatedCorners:
+      return "repeated_corners";
+    case FaceIssue::NotPlanar:
+      return "not_planar";
+  }
+  return "unknown";
+}
+
+std::size_t noted_faces(std::span<const FaceNote> notes) {
+  std::size_t faces = 0;
+  for (size_t i = 0; i < notes.size(); ++i)
+    if (i == 0 || notes[i].face != notes[i - 1].face) ++faces;
+  return faces;
+}
+
 Scene make_scene(const SceneArrays& a) {
   check_sizes(a);
   check_values(a);
@@ -319,23 +346,26 @@ Scene make_scene(const SceneArrays& a) {
     const double diameter = polygon_diameter(polygon);
     const dvec3 area_normal = polygon_area_normal(polygon);
     if (polygon.size() < 3 || !(glm::length(area_normal) > kDegenerate * diameter * diameter)) {
-      const char* why = !(diameter > 0.0) ? "zero area (coincident vertices)"
-                        : turns(polygon, diameter)
-                            ? "its outline crosses itself"  // lobes that cancel
-                            : "zero area (collinear vertices)";
-      scene.skipped.push_back({face, why});
+      const FaceIssue why = !(diameter > 0.0) ? FaceIssue::CoincidentCorners
+                            : turns(polygon, diameter)
+                                ? FaceIssue::CrossesItself  // lobes that cancel
+                                : FaceIssue::CollinearCorners;
+      scene.skipped.push_back({.face = face, .issue = why});
       continue;
     }
     if (diameter < smallest_face) {
-      std::ostringstream m;
-      m << "too small to solve (" << diameter << " across, in a scene " << scene.diameter
-        << " across)";
-      scene.skipped.push_back({face, m.str()});
+      scene.skipped.push_back({.face = face,
+                               .issue = FaceIssue::TooSmall,
+                               .size = diameter,
+                               .scene_size = scene.diameter});
       continue;
     }
-    std::ostringstream repairs;
-    if (repeated)
-      repairs << repeated << " repeated corner" << (repeated > 1 ? "s" : "") << " removed; ";
+    std::vector<FaceNote> repairs;
+    if (repeated) {
+      repairs.push_back({.face = face,
+                         .issue = FaceIssue::RepeatedCorners,
+                         .count = static_cast<std::uint32_t>(repeated)});
+    }
     if (polygon.size() == 3 || (polygon.size() == 4 && is_convex_planar_quad(polygon))) {
       builder.add(polygon);
     } else {
@@ -344,7 +374,7 @@ Scene make_scene(const SceneArrays& a) {
       if (self_intersecting(flat) || !triangulate(flat, triangles)) {
         // A bow-tie has no inside: Blender draws it as triangles that overlap,
         // facing opposite ways, and each would send its light twice.
-        scene.skipped.push_back({face, "its outline crosses itself"});
+        scene.skipped.push_back({.face = face, .issue = FaceIssue::CrossesItself});
         continue;
       }
       for (const auto& t : triangles) {
@@ -353,24 +383,22 @@ Scene make_scene(const SceneArrays& a) {
       }
       const double bent = bend(polygon, normal, diameter);
       if (bent > kPlanar) {
-        repairs << "not planar (bends by " << 100.0 * bent << " % of its size): split into "
-                << builder.made << " planar triangles; ";
+        repairs.push_back({.face = face,
+                           .issue = FaceIssue::NotPlanar,
+                           .count = static_cast<std::uint32_t>(builder.made),
+                           .bend = bent});
       }
     }
     if (builder.made == 0) {
-      scene.skipped.push_back({face, "degenerate after triangulation"});
+      scene.skipped.push_back({.face = face, .issue = FaceIssue::NoTriangles});
       continue;
     }
-    std::string repaired = repairs.str();
-    if (!repaired.empty()) {
-      repaired.resize(repaired.size() - 2);
-      scene.repaired.push_back({face, repaired});
-    }
+    scene.repaired.insert(scene.repaired.end(), repairs.begin(), repairs.end());
   }
   if (scene.patches.empty()) {
     fail("every face is degenerate or broken and was skipped (face " +
-         std::to_string(scene.skipped.front().face) + ": " + scene.skipped.front().what +
-         "); nothing to solve");
+         std::to_string(scene.skipped.front().face) + ": " +
+         std::string(face_issue_name(scene.skipped.front().issue)) + "); nothing to solve");
   }
   mesh_contacts(scene);
   for (const Patch& p : scene.patches) {

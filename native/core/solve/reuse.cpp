@@ -30,43 +30,45 @@ bool same_geometry(const Light& a, const Light& b) {
          a.cosine_falloff == b.cosine_falloff;
 }
 
-std::string options_refusal(const SolveOptions& a, const SolveOptions& b) {
-  if (a.oracle != b.oracle) return "the oracle changed";
-  if (a.quality != b.quality) return "the quality changed";
-  if (a.visibility != b.visibility || a.rays != b.rays) return "the visibility changed";
-  if (a.bounces || b.bounces) return "a fixed number of bounces was asked";
-  if (a.min_element_area != b.min_element_area) return "the smallest element changed";
+RelightRefusal options_refusal(const SolveOptions& a, const SolveOptions& b) {
+  if (a.oracle != b.oracle) return RelightRefusal::OracleChanged;
+  if (a.quality != b.quality) return RelightRefusal::QualityChanged;
+  if (a.visibility != b.visibility || a.rays != b.rays) return RelightRefusal::VisibilityChanged;
+  if (a.bounces || b.bounces) return RelightRefusal::FixedBounces;
+  if (a.min_element_area != b.min_element_area) return RelightRefusal::SmallestElementChanged;
   if (a.leaf_links != b.leaf_links || a.cluster_separation != b.cluster_separation)
-    return "the linking options changed";
-  return "";
+    return RelightRefusal::LinkingChanged;
+  return RelightRefusal::None;
 }
 
 }  // namespace
 
-std::string relight_refusal(const Scene& kept, const SolveOptions& kept_options, const Scene& scene,
-                            const SolveOptions& options) {
-  if (std::string why = options_refusal(kept_options, options); !why.empty()) return why;
+RelightRefusal relight_refusal(const Scene& kept, const SolveOptions& kept_options,
+                               const Scene& scene, const SolveOptions& options) {
+  if (const RelightRefusal why = options_refusal(kept_options, options);
+      why != RelightRefusal::None)
+    return why;
   if (kept.patches.size() != scene.patches.size() ||
       kept.occluders.size() != scene.occluders.size())
-    return "the geometry changed";
+    return RelightRefusal::GeometryChanged;
   // A light (or the world) that gives nothing is left out of the scene (make_scene).
-  if (kept.lights.size() != scene.lights.size())
-    return "a light was added or removed, or turned on or off";
+  if (kept.lights.size() != scene.lights.size()) return RelightRefusal::LightsAddedOrRemoved;
   for (size_t i = 0; i < kept.occluders.size(); ++i)
-    if (!same_geometry(kept.occluders[i], scene.occluders[i])) return "the geometry changed";
+    if (!same_geometry(kept.occluders[i], scene.occluders[i]))
+      return RelightRefusal::GeometryChanged;
   for (size_t i = 0; i < kept.lights.size(); ++i)
-    if (!same_geometry(kept.lights[i], scene.lights[i])) return "a light moved or changed shape";
+    if (!same_geometry(kept.lights[i], scene.lights[i])) return RelightRefusal::LightChanged;
   for (size_t i = 0; i < kept.patches.size(); ++i) {
     const Patch &a = kept.patches[i], &b = scene.patches[i];
-    if (!same_geometry(a, b)) return "the geometry changed";
+    if (!same_geometry(a, b)) return RelightRefusal::GeometryChanged;
     for (size_t s = 0; s < 2; ++s) {
       if (shines(b.sides[s].emission) && !shines(a.sides[s].emission))
-        return "a surface that did not emit light does";
+        return RelightRefusal::NowEmits;
       if (shines(b.sides[s].reflectance) && !shines(a.sides[s].reflectance))
-        return "a black surface now reflects light";
+        return RelightRefusal::NowReflects;
     }
   }
-  return "";
+  return RelightRefusal::None;
 }
 
 double lighting_scale(const Scene& kept, const Scene& scene) {

@@ -11,15 +11,15 @@
 namespace radiosity {
 
 // Why `scene` solved with `options` cannot reuse the elements and links made
-// for `kept` with `kept_options` ("" if it can). Allowed to differ: the
+// for `kept` with `kept_options` (None if it can). Allowed to differ: the
 // sides' emission and reflectance, where what emits or reflects is a subset
 // of what did (links are made only from surfaces that emit or reflect to
 // surfaces that reflect, and only where light reaches), and the colours of
 // the lights (one turned off or on is left out of or added to the scene:
 // refused); and the limits (time, elements, memory, threads, priority,
 // tolerance, iterations).
-std::string relight_refusal(const Scene& kept, const SolveOptions& kept_options, const Scene& scene,
-                            const SolveOptions& options);
+RelightRefusal relight_refusal(const Scene& kept, const SolveOptions& kept_options,
+                               const Scene& scene, const SolveOptions& options);
 
 // About how much brighter `scene`'s lighting is than `kept`'s: the ratio of
 // their emitted power plus the lights' luminances, exact when every emitter and

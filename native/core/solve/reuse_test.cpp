@@ -20,15 +20,19 @@ test::Arrays room(double lamp = 1.0, double floor_rho = 0.5, double shelf_emits 
 
 TEST(RelightRefusal, TheSameSceneAndOptionsRelight) {
   const SolveOptions options;
-  EXPECT_EQ(relight_refusal(room().scene(), options, room().scene(), options), "");
+  EXPECT_EQ(relight_refusal(room().scene(), options, room().scene(), options),
+            RelightRefusal::None);
 }
 
 TEST(RelightRefusal, LightingWithinWhatWasLinkedRelights) {
   const SolveOptions options;
   const Scene kept = room().scene();
-  EXPECT_EQ(relight_refusal(kept, options, room(3.0).scene(), options), "");       // brighter lamp
-  EXPECT_EQ(relight_refusal(kept, options, room(1.0, 0.9).scene(), options), "");  // paler floor
-  EXPECT_EQ(relight_refusal(kept, options, room(1.0, 0.0).scene(), options), "");  // black floor
+  EXPECT_EQ(relight_refusal(kept, options, room(3.0).scene(), options),
+            RelightRefusal::None);  // brighter lamp
+  EXPECT_EQ(relight_refusal(kept, options, room(1.0, 0.9).scene(), options),
+            RelightRefusal::None);  // paler floor
+  EXPECT_EQ(relight_refusal(kept, options, room(1.0, 0.0).scene(), options),
+            RelightRefusal::None);  // black floor
 }
 
 TEST(RelightRefusal, LimitsMayChange) {
@@ -40,7 +44,8 @@ TEST(RelightRefusal, LimitsMayChange) {
   options.yield_to_interface = true;
   options.tolerance = 1e-4;
   options.max_iterations = 10;
-  EXPECT_EQ(relight_refusal(room().scene(), kept_options, room().scene(), options), "");
+  EXPECT_EQ(relight_refusal(room().scene(), kept_options, room().scene(), options),
+            RelightRefusal::None);
 }
 
 TEST(RelightRefusal, OptionsTheLinksWereMadeWithMayNot) {
@@ -51,14 +56,15 @@ TEST(RelightRefusal, OptionsTheLinksWereMadeWithMayNot) {
     change(options);
     return relight_refusal(scene, kept, scene, options);
   };
-  EXPECT_EQ(refusal([](SolveOptions& o) { o.oracle = Oracle::Standard; }), "the oracle changed");
-  EXPECT_EQ(refusal([](SolveOptions& o) { o.quality = 0.7; }), "the quality changed");
-  EXPECT_EQ(refusal([](SolveOptions& o) { o.rays = 64; }), "the visibility changed");
-  EXPECT_EQ(refusal([](SolveOptions& o) { o.bounces = 3; }), "a fixed number of bounces was asked");
+  EXPECT_EQ(refusal([](SolveOptions& o) { o.oracle = Oracle::Standard; }),
+            RelightRefusal::OracleChanged);
+  EXPECT_EQ(refusal([](SolveOptions& o) { o.quality = 0.7; }), RelightRefusal::QualityChanged);
+  EXPECT_EQ(refusal([](SolveOptions& o) { o.rays = 64; }), RelightRefusal::VisibilityChanged);
+  EXPECT_EQ(refusal([](SolveOptions& o) { o.bounces = 3; }), RelightRefusal::FixedBounces);
   EXPECT_EQ(refusal([](SolveOptions& o) { o.min_element_area = 1e-3; }),
-            "the smallest element changed");
+            RelightRefusal::SmallestElementChanged);
   EXPECT_EQ(refusal([](SolveOptions& o) { o.leaf_links = SolveOptions::LeafLinks::All; }),
-            "the linking options changed");
+            RelightRefusal::LinkingChanged);
 }
 
 TEST(RelightRefusal, GeometryAndNewLightPathsMayNot) {
@@ -66,21 +72,22 @@ TEST(RelightRefusal, GeometryAndNewLightPathsMayNot) {
   const Scene kept = room().scene();
   test::Arrays moved = room();
   moved.positions[2] += 1e-9;
-  EXPECT_EQ(relight_refusal(kept, options, moved.scene(), options), "the geometry changed");
+  EXPECT_EQ(relight_refusal(kept, options, moved.scene(), options),
+            RelightRefusal::GeometryChanged);
   test::Arrays more = room();
   more.square(dvec3(3.0, 0.0, 0.0), 1.0, true, 0.5, 0.0);
-  EXPECT_EQ(relight_refusal(kept, options, more.scene(), options), "the geometry changed");
+  EXPECT_EQ(relight_refusal(kept, options, more.scene(), options), RelightRefusal::GeometryChanged);
   EXPECT_EQ(relight_refusal(kept, options, room(1.0, 0.5, 2.0).scene(), options),
-            "a surface that did not emit light does");
+            RelightRefusal::NowEmits);
   EXPECT_EQ(relight_refusal(room(1.0, 0.0).scene(), options, room().scene(), options),
-            "a black surface now reflects light");
+            RelightRefusal::NowReflects);
 }
 
 TEST(RelightRefusal, TakeLightingCopiesTheLightingOnly) {
   Scene kept = room().scene();
   const Scene brighter = room(4.0, 0.8).scene();
   take_lighting(kept, brighter);
-  EXPECT_EQ(relight_refusal(kept, SolveOptions{}, brighter, SolveOptions{}), "");
+  EXPECT_EQ(relight_refusal(kept, SolveOptions{}, brighter, SolveOptions{}), RelightRefusal::None);
   for (size_t i = 0; i < kept.patches.size(); ++i) {
     for (size_t s = 0; s < 2; ++s) {
       EXPECT_EQ(kept.patches[i].sides[s].emission, brighter.patches[i].sides[s].emission);
@@ -108,7 +115,7 @@ TEST(SolveReuse, RelightsAStrongerLampWithoutLinking) {
   ASSERT_TRUE(reuse.holds());
   EXPECT_FALSE(first.stats.reused);
   const SolveResult relit = solve(room(4.0).scene(), options, {}, {}, &reuse);
-  EXPECT_TRUE(relit.stats.reused) << relit.stats.reuse_refusal;
+  EXPECT_TRUE(relit.stats.reused) << relight_refusal_name(relit.stats.reuse_refusal);
   EXPECT_EQ(relit.stats.link_cpu.samples_clear + relit.stats.link_cpu.samples_occluded, 0u);
   ASSERT_EQ(relit.mesh.positions, first.mesh.positions);
   for (size_t i = 0; i < first.mesh.radiance.size(); ++i)

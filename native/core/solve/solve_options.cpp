@@ -94,6 +94,38 @@ std::string_view stop_reason_name(StopReason reason) {
   return "unknown";
 }
 
+std::string_view relight_refusal_name(RelightRefusal refusal) {
+  switch (refusal) {
+    case RelightRefusal::None:
+      return "";
+    case RelightRefusal::NothingKept:
+      return "nothing_kept";
+    case RelightRefusal::OracleChanged:
+      return "oracle_changed";
+    case RelightRefusal::QualityChanged:
+      return "quality_changed";
+    case RelightRefusal::VisibilityChanged:
+      return "visibility_changed";
+    case RelightRefusal::FixedBounces:
+      return "fixed_bounces";
+    case RelightRefusal::SmallestElementChanged:
+      return "smallest_element_changed";
+    case RelightRefusal::LinkingChanged:
+      return "linking_changed";
+    case RelightRefusal::GeometryChanged:
+      return "geometry_changed";
+    case RelightRefusal::LightsAddedOrRemoved:
+      return "lights_added_or_removed";
+    case RelightRefusal::LightChanged:
+      return "light_changed";
+    case RelightRefusal::NowEmits:
+      return "now_emits";
+    case RelightRefusal::NowReflects:
+      return "now_reflects";
+  }
+  return "unknown";
+}
+
 namespace {
 
 // The shortest text that reads back as the same double.

@@ -761,7 +761,7 @@ SolveResult Solver::end() {
   complete_ = !cancelled() && !cut_short_ && !refinement_cut_short_ && stats_.passes > 0;
   // The counts stay those of the last snapshot: the solution returned.
   stats_.skipped_faces = scene_.skipped.size();
-  stats_.repaired_faces = scene_.repaired.size();
+  stats_.repaired_faces = noted_faces(scene_.repaired);
   track_memory();
   stats_.seconds = elapsed();
   result_.stats = stats_;
@@ -806,8 +806,8 @@ std::size_t SolveReuse::memory_bytes() const {
                : 0;
 }
 
-std::string SolveReuse::refusal(const Scene& scene, const SolveOptions& options) const {
-  if (!kept_) return "no solve is kept";
+RelightRefusal SolveReuse::refusal(const Scene& scene, const SolveOptions& options) const {
+  if (!kept_) return RelightRefusal::NothingKept;
   return relight_refusal(kept_->scene, kept_->solver->options(), scene, options);
 }
 
@@ -851,8 +851,8 @@ SolveResult solve(const Scene& scene, const SolveOptions& options, const Progres
   }
   auto run = [&] {
     if (!reuse) return Solver(scene, checked).run(progress, cancel);
-    std::string refusal = reuse->refusal(scene, checked);
-    if (refusal.empty()) {
+    const RelightRefusal refusal = reuse->refusal(scene, checked);
+    if (refusal == RelightRefusal::None) {
       SolveReuse::Kept& kept = *reuse->kept_;
       const double scale = lighting_scale(kept.scene, scene);
       take_lighting(kept.scene, scene);
@@ -865,7 +865,7 @@ SolveResult solve(const Scene& scene, const SolveOptions& options, const Progres
     kept->scene = scene;
     kept->solver = std::make_unique<Solver>(kept->scene, checked);
     SolveResult solved = kept->solver->run(progress, cancel);
-    solved.stats.reuse_refusal = std::move(refusal);
+    solved.stats.reuse_refusal = refusal;
     if (kept->solver->complete()) reuse->kept_ = std::move(kept);
     return solved;
   };

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "radiosity/color.h"
@@ -91,11 +92,33 @@ struct Patch {
   std::array<float, 4> edge_inset{};  // edge k runs from corner k to k + 1
 };
 
-// An input face left out (why), or solved after a repair (what was done).
+// What was found wrong with an input face: why it was left out, or what was
+// repaired before it was solved. Data, not words: the add-on words it.
+enum class FaceIssue : std::uint8_t {
+  CoincidentCorners,  // left out: zero area, its corners in one place
+  CollinearCorners,   // left out: zero area, its corners on one line
+  CrossesItself,      // left out: its outline crosses itself (it has no inside)
+  TooSmall,           // left out: too small to solve in floating point (`size` across)
+  NoTriangles,        // left out: nothing was left of it after triangulation
+  RepeatedCorners,    // repaired: `count` repeated corners removed
+  NotPlanar,          // repaired: bends by `bend`, split into `count` planar triangles
+};
+// "coincident_corners", "not_planar", ...: as the Python API names them.
+std::string_view face_issue_name(FaceIssue issue);
+
 struct FaceNote {
   std::uint32_t face;
-  std::string what;
+  FaceIssue issue;
+  std::uint32_t count = 0;  // RepeatedCorners: corners removed; NotPlanar: triangles made
+  // TooSmall: the face's diameter and the scene's; NotPlanar: the corners'
+  // largest distance from the face's plane as a fraction of its diameter.
+  double size = 0.0;
+  double scene_size = 0.0;
+  double bend = 0.0;
 };
+
+// How many faces `notes` (in face order, as Scene lists them) concern.
+std::size_t noted_faces(std::span<const FaceNote> notes);
 
 struct Scene {
   std::vector<Patch> patches;
@@ -104,8 +127,8 @@ struct Scene {
   // those merged into a coinciding face.
   std::vector<Patch> occluders;
   std::vector<FaceNote> skipped;
-  // Faces solved after a repair: repeated corners removed, non-planar or
-  // self-crossing outlines split into triangles (with how far they bend).
+  // Faces solved after a repair, one note per repair: repeated corners
+  // removed, non-planar outlines split into triangles (with how far they bend).
   std::vector<FaceNote> repaired;
   // Direct light that is not a surface: the scene's lights, then the sky when
   // the world is not black (lights.h, direct_light.h).

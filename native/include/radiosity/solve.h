@@ -106,6 +106,23 @@ enum class SolvePhase : std::uint8_t {
 // Why the solve stopped.
 enum class StopReason : std::uint8_t { Quality, MaxElements, Memory, TimeBudget, Cancel };
 
+// Why a solve given a SolveReuse did not relight the solve it keeps.
+enum class RelightRefusal : std::uint8_t {
+  None,           // it could (and did)
+  NothingKept,    // no complete solve was kept yet
+  OracleChanged,  // options the links were made with changed: ...
+  QualityChanged,
+  VisibilityChanged,       // the visibility mode or its rays
+  FixedBounces,            // a fixed number of bounces was asked (then or now)
+  SmallestElementChanged,  // min_element_area
+  LinkingChanged,          // leaf_links or cluster_separation
+  GeometryChanged,
+  LightsAddedOrRemoved,  // or turned on or off (a light that gives nothing is left out)
+  LightChanged,          // a light moved or changed shape
+  NowEmits,              // a surface that did not emit light does
+  NowReflects,           // a black surface now reflects light
+};
+
 // The names of the options' and reports' values, as the Python API and the
 // add-on spell them ("perceptual", "exact", "near", "refining", "time_budget"):
 // one table per enum (core/solve/option_names.cpp).
@@ -117,6 +134,7 @@ std::optional<SolveOptions::LeafLinks> parse_leaf_links(std::string_view name);
 std::string_view leaf_links_name(SolveOptions::LeafLinks links);
 std::string_view phase_name(SolvePhase phase);
 std::string_view stop_reason_name(StopReason reason);
+std::string_view relight_refusal_name(RelightRefusal refusal);  // "" for None
 
 // SolveOptions{} and the limits as a JSON object, by the names above: the
 // defaults the add-on's settings start from (solver_defaults.json, written at
@@ -176,8 +194,9 @@ struct SolveStats {
   std::size_t skipped_faces = 0;
   std::size_t repaired_faces = 0;  // solved after a repair (Scene::repaired)
   bool cancelled = false;
-  bool reused = false;        // relit with the elements and links of a kept solve (SolveReuse)
-  std::string reuse_refusal;  // with a SolveReuse not reused: why (SolveReuse::refusal)
+  bool reused = false;  // relit with the elements and links of a kept solve (SolveReuse)
+  // With a SolveReuse not reused: why (SolveReuse::refusal).
+  RelightRefusal reuse_refusal = RelightRefusal::None;
   StopReason stopped_by = StopReason::Quality;
   double seconds = 0.0;
   double seconds_linking = 0.0;
@@ -221,11 +240,11 @@ class SolveReuse {
   bool holds() const { return kept_ != nullptr; }
   void clear();
   std::size_t memory_bytes() const;
-  // Why `scene` cannot be relit with `options` from what is kept ("" if it can):
-  // nothing kept; options other than the limits changed; the geometry changed;
-  // a light was added, removed, turned on or off; a surface emits or reflects
-  // that did not before (the links it needs were never made).
-  std::string refusal(const Scene& scene, const SolveOptions& options) const;
+  // Why `scene` cannot be relit with `options` from what is kept (None if it
+  // can): nothing kept; options other than the limits changed; the geometry
+  // changed; a light was added, removed, turned on or off; a surface emits or
+  // reflects that did not before (the links it needs were never made).
+  RelightRefusal refusal(const Scene& scene, const SolveOptions& options) const;
 
  private:
   friend SolveResult solve(const Scene&, const SolveOptions&, const ProgressCallback&,
