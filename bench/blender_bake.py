@@ -104,7 +104,7 @@ def bake(scene, obj, samples):
 
 def main():
     jobs = common.start_jobs()
-    from radiosity import export
+    from radiosity.read import export
 
     scene = bpy.context.scene
     arrays = export.export_scene(bpy.context).arrays

@@ -25,7 +25,8 @@ def main():
     parser.add_argument("--out", required=True)
     args = common.arguments(parser)
     common.enable_addon(args.addon)
-    from radiosity import export, findings
+    from radiosity.model import findings
+    from radiosity.read import export
 
     common.lambertian_scene()
     exported = export.export_scene(bpy.context)

@@ -92,7 +92,7 @@ def visible_edges(scene, result, projection):
 
 
 def render_solutions(scene, jobs, exported, projection):
-    from radiosity import bake, result_state
+    from radiosity.write import bake, result_state
     for job in jobs:
         result = load_result(job["npz"])
         bake.write_refined(scene, exported, result)
@@ -108,7 +108,8 @@ def render_solutions(scene, jobs, exported, projection):
 
 def main():
     jobs = common.start_jobs()
-    from radiosity import export, result_state
+    from radiosity.read import export
+    from radiosity.write import result_state
 
     scene = bpy.context.scene
     width, height = jobs["width"], jobs["height"]

@@ -1,4 +1,6 @@
-"""Shared pieces of the scene builders (runs inside Blender).
+"""Shared pieces of the scene builders: geometry as numpy arrays (no Blender
+needed), and the functions that make objects, materials, a camera and render
+settings from it inside Blender (each imports bpy when called).
 
 Geometry is built from numpy arrays of quads with outward (for objects) or
 inward (for rooms) normals, so every face's front side is the side that sees
@@ -10,9 +12,7 @@ reference for the radiosity solution: CPU, Standard view transform, enough
 diffuse bounces, no clamping.
 """
 
-import bpy
 import numpy as np
-from mathutils import Vector
 
 # Corners of the unit box, index = x + 2 y + 4 z, each coordinate -0.5 or +0.5.
 _BOX_CORNERS = np.array([[x, y, z] for z in (-0.5, 0.5) for y in (-0.5, 0.5) for x in (-0.5, 0.5)])
@@ -29,6 +29,8 @@ BOX_FACES = {
 
 def empty_file():
     """Start from an empty file (no factory cube, light or camera)."""
+    import bpy
+
     bpy.ops.wm.read_factory_settings(use_empty=True)
     return bpy.context.scene
 
@@ -110,6 +112,8 @@ def ceiling_light(center, size_x, size_y):
 def add_mesh(scene, name, geometry, material, location=(0, 0, 0), rotation=(0, 0, 0)):
     """Link a new object made of `geometry` = (vertices, faces: an array of quads
     or a list of vertex index lists) to the scene."""
+    import bpy
+
     verts, faces = geometry
     mesh = bpy.data.meshes.new(name)
     mesh.from_pydata(verts.tolist(), [], faces.tolist() if hasattr(faces, "tolist") else faces)
@@ -138,6 +142,8 @@ def principled_input(node, name):
 
 def diffuse_material(name, color):
     """A diffuse material: Principled BSDF with `color` (linear RGB) and no specular."""
+    import bpy
+
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     bsdf = mat.node_tree.nodes["Principled BSDF"]
@@ -151,6 +157,8 @@ def lambertian_material(name, color):
     """A Lambertian material: a Diffuse BSDF of `color` (linear RGB), the surface
     radiosity models exactly (the Principled BSDF's diffuse is not Lambertian).
     The Diffuse BSDF node and its Color input are the same in Blender 3.x to 5.x."""
+    import bpy
+
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     nodes, links = mat.node_tree.nodes, mat.node_tree.links
@@ -166,6 +174,8 @@ def lambertian_material(name, color):
 
 def emission_material(name, strength, color=(1.0, 1.0, 1.0)):
     """A light: an Emission shader of radiance color x strength, nothing else."""
+    import bpy
+
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     nodes, links = mat.node_tree.nodes, mat.node_tree.links
@@ -182,6 +192,9 @@ def emission_material(name, strength, color=(1.0, 1.0, 1.0)):
 
 def add_camera(scene, location, target, lens=20.0):
     """A camera at `location` looking at `target`, set as the scene camera."""
+    import bpy
+    from mathutils import Vector
+
     data = bpy.data.cameras.new("Camera")
     data.lens = lens
     data.clip_start = 0.01
@@ -205,6 +218,8 @@ def cycles_denoiser_available():
 
 def setup_render(scene, resolution=(640, 480), samples=128):
     """Cycles on the CPU, Standard view transform, a black world."""
+    import bpy
+
     scene.render.engine = 'CYCLES'
     scene.cycles.device = 'CPU'
     scene.cycles.samples = samples

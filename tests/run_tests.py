@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Runs every test of the project and prints one summary line.
 
-Three kinds of tests, run in this order (a fourth on request):
+Four kinds of tests, run in this order (a fifth on request):
   ctest           the C++ unit tests registered with CTest in the build dir
   native/test_*   unittest files for the `_radiosity` module (and the study's
                   `_image_metric`), run by /usr/bin/python3 with build/addon/radiosity
@@ -10,6 +10,9 @@ Three kinds of tests, run in this order (a fourth on request):
                   environment of tools/cpython.py's CPython), which imports the
                   add-on's module for its own version (native-3.10/test_module.py;
                   but for NATIVE_ONCE, the solver's numerics, the same in each)
+  model/test_*    unittest files for the add-on's bpy-free model (addon/model), run
+                  like native/test_* (build/addon/radiosity on sys.path: `from model
+                  import arrays`), also in each CPython given
   blender/test_*  unittest files run inside each Blender given (--blender, repeatable:
                   3.4, 4.5, 5.0, 5.2 of tools/blenders.py, installed when missing, or a
                   path), `blender --background --factory-startup`, one process per file,
@@ -271,10 +274,11 @@ def pattern_options(patterns):
 def python_jobs(args, build, tmp):
     """(name, Blender label or None, command, json path) of every selected Python test file."""
     everything = lambda testfile: True  # noqa: E731
-    kinds = [] if args.only_platforms else [("native", None, args.python, native_command, everything)]
-    kinds += [("native-%s" % version, None, python, native_command,
+    kinds = [] if args.only_platforms else [(group, None, args.python, native_command, everything)
+                                            for group in ("native", "model")]
+    kinds += [("%s-%s" % (group, version), None, python, native_command,
                lambda testfile: testfile.name not in NATIVE_ONCE)
-              for version, python in args.native_exes]
+              for version, python in args.native_exes for group in ("native", "model")]
     kinds += [("blender-%s" % label, label, exe, blender_command,
                everything if full else lambda testfile: testfile.name in PACKAGE_CHECK)
               for label, exe, full in args.blender_exes]
@@ -282,7 +286,7 @@ def python_jobs(args, build, tmp):
         kinds.append(("platforms", None, args.python, native_command, everything))
     jobs = []
     for group, label, program, make_cmd, selected in kinds:
-        # tests/blender, tests/native (also the native-3.X groups), tests/platforms
+        # tests/blender, tests/native and tests/model (also their -3.X groups), tests/platforms
         folder = TESTS / ("blender" if label else group.split("-")[0])
         for testfile in filter(selected, sorted(folder.glob("test_*.py"))):
             name = "%s/%s" % (group, testfile.name)

@@ -33,7 +33,7 @@ not finish within 300 s", "ran out at 8.0 GB") with the largest resident
 memory seen. Prints a table; JSON in <build>/furnished/results.json.
 
 Diffuse-only: every material is replaced by a Diffuse BSDF of the reflectance
-the add-on reads from it (addon/export.py MaterialReader: Base Color, an image
+the add-on reads from it (addon/read/export.py MaterialReader: Base Color, an image
 texture's average, ...), plus its emission; where the add-on does not know the
 node setup (the glTF importer's Glossy + Diffuse), the first Diffuse or
 Principled BSDF's colour. Both the reference and the solve see those
@@ -73,7 +73,7 @@ def make_diffuse(scene):
     """Every material a Diffuse BSDF of the reflectance the add-on reads (see the docstring)."""
     import bpy
     import numpy as np
-    from radiosity import export
+    from radiosity.read import export
     reader = export.MaterialReader()
     for material in bpy.data.materials:
         rho, emission = reader.read(material)

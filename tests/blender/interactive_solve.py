@@ -52,7 +52,7 @@ def fail(err):
 
 
 addon_utils.enable("radiosity", default_set=False, handle_error=fail)
-from radiosity import operators  # noqa: E402  (the add-on, enabled above)
+from radiosity.ui import operators  # noqa: E402  (the add-on, enabled above)
 bpy.context.preferences.system.viewport_aa = 'OFF'  # see above; --factory-startup saves no preferences
 state = {"start": None, "invoke": None, "fractions": [], "by_pass": [], "last_progress": None,
          "ticks": 0, "running_seconds": 0.0, "mesh_states": [], "updates_while_running": 0,

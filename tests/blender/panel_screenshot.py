@@ -36,7 +36,8 @@ def fail(err):
 
 
 addon_utils.enable("radiosity", default_set=False, handle_error=fail)
-from radiosity import operators, result_state, ui  # noqa: E402  (the add-on, enabled above)
+from radiosity.ui import operators, panels  # noqa: E402  (the add-on, enabled above)
+from radiosity.write import result_state
 
 # The progress dict an interactive solve reports (operators.running_progress).
 FAKE_PROGRESS = {"fraction": 0.43, "pass": 2, "passes": 7, "leaves": 12316, "elements": 24631,
@@ -137,7 +138,7 @@ def show_sidebar(attempt=0):
 
 def count_sidebar_draws():
     """Counts the draws of the sidebar's Radiosity panel (drawn only on its tab)."""
-    drawn = ui.VIEW3D_PT_radiosity.draw
+    drawn = panels.VIEW3D_PT_radiosity.draw
 
     def draw(panel, context):
         state["sidebar_draws"] = state.get("sidebar_draws", 0) + 1

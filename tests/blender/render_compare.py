@@ -48,7 +48,7 @@ def render_image(scene, samples, resolution=(96, 72), seed=None):
 
 def emitter_objects(scene):
     """Objects that emit: lights, and meshes with a material the add-on reads as emitting."""
-    from radiosity import export
+    from radiosity.read import export
     reader = export.MaterialReader()
     return [o for o in scene.objects if o.type == 'LIGHT' or (
         o.type == 'MESH' and any(reader.read(s.material)[1].max() > 0 for s in o.material_slots))]

@@ -11,7 +11,7 @@ import time
 
 import bpy
 
-from radiosity import native, pipeline
+from radiosity.solve import native, pipeline
 from test_solve import ADDON_DIR, build_file, open_scene
 
 HERE = os.path.dirname(os.path.abspath(__file__))

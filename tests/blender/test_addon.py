@@ -14,8 +14,10 @@ import addon_utils
 import bpy
 
 import radiosity
-from radiosity import (bake, native, operators, pipeline, progress_text, properties, quality_meaning, result_state,
-                       ui)
+from radiosity.model import progress_text, quality_meaning
+from radiosity.solve import native, pipeline
+from radiosity.ui import operators, panels, properties
+from radiosity.write import bake, result_state
 from layout_check import DEFAULT_REGION_WIDTH, CheckedLayout, FakeContext, FakePanel, layout_width
 
 # Every type the add-on registers, by its base type and RNA name.
@@ -33,8 +35,8 @@ ADDON_TYPES = (
     (bpy.types.Panel, "VIEW3D_PT_radiosity"),
     (bpy.types.Menu, "VIEW3D_MT_radiosity"),
 )
-PANELS = (ui.RENDER_PT_radiosity, ui.RENDER_PT_radiosity_quality, ui.RENDER_PT_radiosity_output,
-          ui.RENDER_PT_radiosity_stats)
+PANELS = (panels.RENDER_PT_radiosity, panels.RENDER_PT_radiosity_quality, panels.RENDER_PT_radiosity_output,
+          panels.RENDER_PT_radiosity_stats)
 MENU_OPERATORS = ["radiosity.solve", "radiosity.toggle_result", "radiosity.clear"]
 # What a running solve reports (operators.running_progress).
 PROGRESS = {"fraction": 0.43, "pass": 2, "passes": 7, "leaves": 12316, "elements": 24631,
@@ -144,7 +146,7 @@ class RegistrationTest(unittest.TestCase):
             radiosity.register()
         self.assertEqual(menu_entries(), (1, 1, 1))
         # A second register without unregister (a script's) adds no second entry either.
-        ui.register()
+        panels.register()
         self.assertEqual(menu_entries(), (1, 1, 1))
 
     @staticmethod
@@ -269,7 +271,7 @@ class DefaultsTest(unittest.TestCase):
 
 
 class PanelTest(unittest.TestCase):
-    def draw(self, panel=ui.RENDER_PT_radiosity, width=DEFAULT_REGION_WIDTH, layout=None):
+    def draw(self, panel=panels.RENDER_PT_radiosity, width=DEFAULT_REGION_WIDTH, layout=None):
         """Draw `panel` as in a Properties region `width` wide; return its layout."""
         layout = layout or CheckedLayout()
         panel.draw(FakePanel(layout), FakeContext(width))
@@ -296,7 +298,7 @@ class PanelTest(unittest.TestCase):
         return Running()
 
     def test_poll(self):
-        self.assertTrue(ui.RENDER_PT_radiosity.poll(bpy.context))
+        self.assertTrue(panels.RENDER_PT_radiosity.poll(bpy.context))
         for panel in PANELS:
             registered = getattr(bpy.types, panel.__name__)
             self.assertEqual((registered.bl_space_type, registered.bl_region_type, registered.bl_context),
@@ -331,7 +333,7 @@ class PanelTest(unittest.TestCase):
         settings = set(properties.RadiositySettings.__annotations__) - {"stats"}
         self.assertEqual(sorted(drawn), sorted(settings))
         self.assertEqual(operators_drawn, MENU_OPERATORS + ["radiosity.export_gltf"])
-        self.assertIn("Not solved yet", self.draw(ui.RENDER_PT_radiosity_stats).record["labels"])
+        self.assertIn("Not solved yet", self.draw(panels.RENDER_PT_radiosity_stats).record["labels"])
 
     def test_draws_last_solve_statistics(self):
         stats = bpy.context.scene.radiosity.stats
@@ -339,7 +341,7 @@ class PanelTest(unittest.TestCase):
         stats.elements, stats.links, stats.iterations, stats.seconds = 12345, 67890, 4, 1.5
         stats.warning = "2 point lights not modelled"
         try:
-            labels = self.draw(ui.RENDER_PT_radiosity_stats, width=600).record["labels"]
+            labels = self.draw(panels.RENDER_PT_radiosity_stats, width=600).record["labels"]
         finally:
             stats.clear()
         self.assertEqual(labels, ["Converged", "Oracle", "Perceptual", "Elements", "12,345", "Links", "67,890",
@@ -350,9 +352,9 @@ class PanelTest(unittest.TestCase):
         stats.valid, stats.status, stats.oracle = True, "Converged", "Perceptual"
         try:
             stats.relit = True
-            relit = self.draw(ui.RENDER_PT_radiosity_stats).record["labels"]
+            relit = self.draw(panels.RENDER_PT_radiosity_stats).record["labels"]
             stats.relit, stats.relinked_because = False, "the geometry changed"
-            layout = self.draw(ui.RENDER_PT_radiosity_stats)
+            layout = self.draw(panels.RENDER_PT_radiosity_stats)
         finally:
             stats.clear()
         # Wrapped to the panel's width: read as one text.
@@ -366,8 +368,8 @@ class PanelTest(unittest.TestCase):
         panel = bpy.types.VIEW3D_PT_radiosity
         self.assertEqual((panel.bl_space_type, panel.bl_region_type, panel.bl_category),
                          ('VIEW_3D', 'UI', "Radiosity"))
-        self.assertTrue(ui.VIEW3D_PT_radiosity.poll(bpy.context))
-        layout = self.draw(ui.VIEW3D_PT_radiosity)
+        self.assertTrue(panels.VIEW3D_PT_radiosity.poll(bpy.context))
+        layout = self.draw(panels.VIEW3D_PT_radiosity)
         self.assertEqual(layout.record["operators"], MENU_OPERATORS)
         self.assertEqual([name for _, name in layout.record["props"]], ["oracle", "quality"])
         kind, column = layout._items[0]
@@ -376,12 +378,12 @@ class PanelTest(unittest.TestCase):
 
     def test_settings_at_zero_say_what_zero_means(self):
         settings = bpy.context.scene.radiosity
-        limits = self.draw(ui.RENDER_PT_radiosity_quality, width=600).record["labels"]
+        limits = self.draw(panels.RENDER_PT_radiosity_quality, width=600).record["labels"]
         self.assertIn("Elements, Time Limit at 0: no limit. Min Size at 0: automatic. "
                       "Iterations at 0: until converged.", " ".join(limits))
         settings.max_elements, settings.bounces = 5000, 3
         try:
-            limits = " ".join(self.draw(ui.RENDER_PT_radiosity_quality, width=600).record["labels"])
+            limits = " ".join(self.draw(panels.RENDER_PT_radiosity_quality, width=600).record["labels"])
             self.assertIn("Time Limit at 0: no limit. Min Size at 0: automatic.", limits)
             self.assertNotIn("Elements", limits)
             self.assertNotIn("Iterations", limits)
@@ -393,13 +395,13 @@ class PanelTest(unittest.TestCase):
         stats = bpy.context.scene.radiosity.stats
         stats.valid, stats.status, stats.links = True, "Converged", 0
         try:
-            layout = self.draw(ui.RENDER_PT_radiosity_stats)
+            layout = self.draw(panels.RENDER_PT_radiosity_stats)
             self.assertIn("None", layout.record["labels"])
             self.assertIn("No links: no two surfaces see each other, all light comes straight from the lights",
                           " ".join(layout.record["labels"]))
             self.assert_fits(layout)
             stats.status = "Time budget reached"
-            labels = " ".join(self.draw(ui.RENDER_PT_radiosity_stats).record["labels"])
+            labels = " ".join(self.draw(panels.RENDER_PT_radiosity_stats).record["labels"])
             self.assertIn("No links: the solve stopped before it linked any surfaces", labels)
         finally:
             stats.clear()
@@ -425,7 +427,7 @@ class PanelTest(unittest.TestCase):
                     threshold = rad.quality_threshold(oracle.lower(), quality)
                     texts.append(quality_meaning.quality_meaning(oracle, threshold))
                     with self.subTest(oracle=oracle, quality=quality):
-                        layout = self.draw(ui.RENDER_PT_radiosity_quality)
+                        layout = self.draw(panels.RENDER_PT_radiosity_quality)
                         self.assert_fits(layout)
                         headline, detail = texts[-1]
                         self.assertIn(headline, layout.record["labels"])
@@ -436,7 +438,7 @@ class PanelTest(unittest.TestCase):
                 self.assertNotEqual(texts[0][0], texts[1][0], oracle)
             settings.quality = 0.0
             self.assertIn("No refinement: the coarsest lighting",
-                          self.draw(ui.RENDER_PT_radiosity_quality).record["labels"])
+                          self.draw(panels.RENDER_PT_radiosity_quality).record["labels"])
         finally:
             settings.oracle, settings.quality = saved
 
@@ -474,11 +476,11 @@ class PanelTest(unittest.TestCase):
         native.advice = lambda: native.what_to_do(False)
         try:
             for width in (DEFAULT_REGION_WIDTH, 248, 400):
-                for panel in (ui.RENDER_PT_radiosity, ui.RENDER_PT_radiosity_stats):
+                for panel in (panels.RENDER_PT_radiosity, panels.RENDER_PT_radiosity_stats):
                     with self.subTest(panel=panel.bl_label, width=width):
                         layout = self.draw(panel, width)
                         self.assert_fits(layout, width)
-            labels = self.draw(ui.RENDER_PT_radiosity_stats).record["labels"]
+            labels = self.draw(panels.RENDER_PT_radiosity_stats).record["labels"]
         finally:
             native.advice = saved
             stats.clear()
@@ -510,7 +512,7 @@ class PanelTest(unittest.TestCase):
         else:
             self.assertIn((bpy.context.window_manager, "radiosity_progress"), layout.record["props"])
         self.assertIn("Esc to cancel", layout.record["labels"])
-        self.assertIn(ui.SOLVING_LOCK, " ".join(layout.record["labels"]))
+        self.assertIn(panels.SOLVING_LOCK, " ".join(layout.record["labels"]))
         self.assertEqual(layout.record["operators"][0], "radiosity.solve")
 
     def test_solve_toggle_and_remove_wait_while_a_solve_runs(self):
@@ -580,14 +582,14 @@ class PanelTest(unittest.TestCase):
         layer = bpy.context.view_layer
         active = layer.objects.active
         try:
-            self.assertNotIn(ui.EDIT_WARNING, self.draw(width=600).record["labels"])
+            self.assertNotIn(panels.EDIT_WARNING, self.draw(width=600).record["labels"])
             obj[result_state.RESULT_TAG] = "Cube"
-            self.assertNotIn(ui.EDIT_WARNING, self.draw(width=600).record["labels"])
+            self.assertNotIn(panels.EDIT_WARNING, self.draw(width=600).record["labels"])
             layer.objects.active = obj
-            self.assertIn(ui.EDIT_WARNING, self.draw(width=600).record["labels"])
+            self.assertIn(panels.EDIT_WARNING, self.draw(width=600).record["labels"])
             layer.objects.active = active
             obj.select_set(True)
-            self.assertIn(ui.EDIT_WARNING, self.draw(width=600).record["labels"])
+            self.assertIn(panels.EDIT_WARNING, self.draw(width=600).record["labels"])
             self.assert_fits(self.draw())
         finally:
             layer.objects.active = active

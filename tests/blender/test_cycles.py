@@ -30,7 +30,7 @@ import bpy
 import numpy as np
 
 import render_compare as rc
-from radiosity import result_state
+from radiosity.write import result_state
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "scenes")))
 import scene_kit as kit  # noqa: E402

@@ -1,4 +1,4 @@
-"""Scene export (addon/export.py): what the solver is given for a Blender scene (headless).
+"""Scene export (addon/read/export.py): what the solver is given for a Blender scene (headless).
 
 Materials (Principled, Diffuse, Emission, Mix/Add, image-texture average,
 unknown setups), modifiers and instances through the evaluated depsgraph,
@@ -14,7 +14,9 @@ import unittest
 import bpy
 import numpy as np
 
-from radiosity import arrays, export, findings, result_state
+from radiosity.model import arrays, findings
+from radiosity.read import export
+from radiosity.write import result_state
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "scenes")))
 import scene_kit as kit  # noqa: E402

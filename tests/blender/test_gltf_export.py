@@ -19,7 +19,8 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from radiosity import bake, display_colours, game_export, result_state
+from radiosity.model import display_colours
+from radiosity.write import bake, game_ready, result_state
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "scenes")))
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "tools")))
@@ -133,7 +134,7 @@ class GameReadyBakeTest(unittest.TestCase):
         for name, (co, values, materials) in self.default.items():
             self.assertEqual(materials, [bake.MATERIAL_NAME], name)
         np.testing.assert_allclose(self.default["Light"][1], LIGHT, rtol=1e-5)
-        self.assertFalse(any(m.get(game_export.UNLIT_TAG) for m in bpy.data.materials))
+        self.assertFalse(any(m.get(game_ready.UNLIT_TAG) for m in bpy.data.materials))
 
     def test_game_ready_colours_are_the_display_colours(self):
         for exposure in (0.0, -1.5):
@@ -152,7 +153,7 @@ class GameReadyBakeTest(unittest.TestCase):
                     np.testing.assert_allclose(values, display_colours.game_colours(radiance, settings),
                                                atol=1e-6, err_msg=name)
                     self.assertTrue(np.all((values >= 0.0) & (values <= 1.0)), name)
-                    self.assertEqual([m.name for m in obj.data.materials], [game_export.UNLIT_MATERIAL_NAME])
+                    self.assertEqual([m.name for m in obj.data.materials], [game_ready.UNLIT_MATERIAL_NAME])
                     self.assertTrue(obj.data.materials[0].use_backface_culling)
                 # Standard view: exposed radiance clamped, so the light is white at 0 and
                 # at -1.5 stops (12 x 2^-1.5 = 4.2).
@@ -165,9 +166,9 @@ class GameReadyBakeTest(unittest.TestCase):
         scene.view_settings.view_transform = 'Filmic'
         scene.view_settings.exposure = 0.5
         out = solve(scene)
-        settings, note = game_export.display_settings(scene)
+        settings, note = game_ready.display_settings(scene)
         self.assertEqual(settings.exposure, 0.5)
-        if game_export.import_ocio():
+        if game_ready.import_ocio():
             # OpenColorIO (4.5, 5.0): Filmic's curve, not the Standard one.
             self.assertEqual(note, "")
             self.assertIsNotNone(settings.transform)
@@ -290,7 +291,7 @@ class ExportRefusalTest(unittest.TestCase):
         # was chosen. Background Blender runs 'INVOKE_DEFAULT' as execute (it
         # has no window), so invoke is called as the window would call it.
         from bpy_extras.io_utils import ExportHelper
-        from radiosity import game_export
+        from radiosity.write import gltf_export
         scene = open_cube()
         solve(scene)
         self.assertTrue(bpy.ops.radiosity.export_gltf.poll())
@@ -303,7 +304,7 @@ class ExportRefusalTest(unittest.TestCase):
         opens_the_browser = ExportHelper.invoke
         ExportHelper.invoke = lambda op, context, event: browsed.append(op) or {'RUNNING_MODAL'}
         try:
-            result = game_export.RADIOSITY_OT_export_gltf.invoke(Invoked(), bpy.context, None)
+            result = gltf_export.RADIOSITY_OT_export_gltf.invoke(Invoked(), bpy.context, None)
         finally:
             ExportHelper.invoke = opens_the_browser
         self.assertEqual(result, {'CANCELLED'})
@@ -346,7 +347,7 @@ class ViewTransformTest(unittest.TestCase):
         return pixels.reshape(10, 30, 4)[5, [5, 15, 25], :3]
 
     def test_filmic_look_exposure_gamma_match_a_render(self):
-        if not game_export.import_ocio():
+        if not game_ready.import_ocio():
             self.skipTest("no PyOpenColorIO in this Blender: game-ready colours use Standard")
         bpy.ops.wm.read_homefile(use_empty=True)
         scene = bpy.context.scene
@@ -384,7 +385,7 @@ class ViewTransformTest(unittest.TestCase):
                 continue
         self.assertIn("Medium High Contrast", view.look)
         rendered = self.render(scene)
-        settings, note = game_export.display_settings(scene)
+        settings, note = game_ready.display_settings(scene)
         self.assertEqual(note, "")
         expected = display_colours.display_encoded(self.RADIANCE, settings)
         print("rendered", rendered.round(4).tolist(), "expected", expected.round(4).tolist())

@@ -1,5 +1,5 @@
 """Blender's area-light power-to-radiance conversion, measured in Cycles and checked
-against what the add-on exports (addon/export.py, arrays.area_light_radiance).
+against what the add-on exports (addon/read/export.py, arrays.area_light_radiance).
 
 A white Diffuse BSDF plane 1 m under the light, direct light only, 64 x 64 pixels,
 256 samples, an orthographic camera between them looking down. The mean of the
@@ -28,7 +28,7 @@ import unittest
 import bpy
 import numpy as np
 
-from radiosity import export
+from radiosity.read import export
 
 RESOLUTION = 64
 POWER = 10.0

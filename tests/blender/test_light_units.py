@@ -1,5 +1,5 @@
 """Blender's point, spot and sun lights and a uniform world colour, measured in Cycles and
-checked against the add-on's conversion (addon/light_units.py, whose docstring has the
+checked against the add-on's conversion (addon/model/light_units.py, whose docstring has the
 table of what was measured in 3.4.1, 4.5.15 and 5.0.1).
 
 A white Diffuse BSDF plane (40 m square at z = 0), direct light only (max_bounces 0),
@@ -36,7 +36,8 @@ import unittest
 import bpy
 import numpy as np
 
-from radiosity import compat, light_units
+from radiosity import compat
+from radiosity.model import light_units
 from test_light_conversion import add_mesh, diffuse
 
 RESOLUTION = 64

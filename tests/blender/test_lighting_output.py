@@ -32,7 +32,9 @@ import numpy as np
 
 import image_agreement
 import render_compare as rc
-from radiosity import bake, bake_materials, compat, export, result_state
+from radiosity import compat
+from radiosity.read import export
+from radiosity.write import bake, bake_materials, result_state
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scenes"))

@@ -21,7 +21,7 @@ import numpy as np
 import contact_agreement as ca
 import render_compare as rc
 import scene_kit
-from radiosity import export
+from radiosity.read import export
 
 
 class DefaultSceneTest(unittest.TestCase):

@@ -1,4 +1,4 @@
-"""The pacing of the live result (addon/live_pacing.py): a pass is shown only
+"""The pacing of the live result (addon/ui/live_pacing.py): a pass is shown only
 once the last one's bake and redraws cost at most the display's share of the
 time since; the 3D views' draw handlers it adds are removed again."""
 
@@ -6,7 +6,7 @@ import unittest
 
 import bpy
 
-from radiosity import live_pacing
+from radiosity.ui import live_pacing
 
 
 class LivePacingTest(unittest.TestCase):

@@ -18,7 +18,9 @@ import unittest
 import bpy
 import numpy as np
 
-from radiosity import bake, native, operators, pipeline, result_state, solve_reuse
+from radiosity.solve import native, pipeline, solve_reuse
+from radiosity.ui import operators
+from radiosity.write import bake, result_state
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "scenes")))
 import build_scene  # noqa: E402
@@ -298,7 +300,7 @@ class SolveCubeTest(unittest.TestCase):
 
 class RelightTest(unittest.TestCase):
     """A second solve after only the lighting changed starts from the first's
-    elements and links (addon/solve_reuse.py); any other change links anew and
+    elements and links (addon/solve/solve_reuse.py); any other change links anew and
     the statistics say why."""
 
     def setUp(self):

@@ -1,6 +1,6 @@
 """A solve that fails or is cancelled at any step (the export, the native solve,
 writing its result) leaves the scene exactly as it was, the previous result
-included (addon/scene_transaction.py).
+included (addon/write/scene_transaction.py).
 
 Each step the operator takes after the native solve (replacing the result
 objects, hiding the originals, showing the results, writing the attribute on
@@ -20,7 +20,10 @@ import unittest
 import bpy
 import numpy as np
 
-from radiosity import bake, bake_materials, export, native, operators, pipeline, result_state
+from radiosity.read import export
+from radiosity.solve import native, pipeline
+from radiosity.ui import operators
+from radiosity.write import bake, bake_materials, result_state
 from test_addon import scene_snapshot
 from test_solve import open_scene
 
@@ -153,7 +156,7 @@ class FailingStepsChangeNothing(unittest.TestCase):
         self.check('ORIGINAL', 'LIGHTING')
 
     def test_a_failing_export_changes_nothing(self):
-        from radiosity import export
+        from radiosity.read import export
         scene = open_scene("cube")
         self.assertEqual(bpy.ops.radiosity.solve(), {'FINISHED'})
         before = full_state(scene)

@@ -24,7 +24,8 @@ import unittest
 import bpy
 import numpy as np
 
-from radiosity import bake, export, result_state
+from radiosity.read import export
+from radiosity.write import bake, result_state
 from test_solve import open_scene
 from scene_kit import emission_material  # noqa: E402  (scenes/ is on the path: test_solve)
 

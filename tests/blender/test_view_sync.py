@@ -1,5 +1,5 @@
 """The 3D views' shading follows the result through Solve, Toggle, Remove,
-Undo and Redo (addon/view_sync.py, result_state.sync_views).
+Undo and Redo (addon/ui/view_sync.py, result_state.sync_views).
 
 Undo takes the scene back but not the screens: before view_sync, undoing a
 first solve left every view flat-shaded by the colour attribute (the originals
@@ -12,7 +12,7 @@ import unittest
 
 import bpy
 
-from radiosity import result_state
+from radiosity.write import result_state
 from test_solve import open_scene
 
 
@@ -81,11 +81,11 @@ class ViewsFollowTheResult(unittest.TestCase):
         self.assertFalse(bpy.ops.radiosity.clear.poll())
 
     def test_toggle_icon_shows_the_state(self):
-        from radiosity import ui
+        from radiosity.ui import panels
         step("solve", bpy.ops.radiosity.solve)
-        self.assertEqual(ui.toggle_icon(bpy.context.scene), 'HIDE_OFF')
+        self.assertEqual(panels.toggle_icon(bpy.context.scene), 'HIDE_OFF')
         step("toggle", bpy.ops.radiosity.toggle_result)
-        self.assertEqual(ui.toggle_icon(bpy.context.scene), 'HIDE_ON')
+        self.assertEqual(panels.toggle_icon(bpy.context.scene), 'HIDE_ON')
 
 
 if __name__ == "__main__":

@@ -2,7 +2,7 @@
 (native/core/hierarchy/output_mesh.cpp), checked on solved synthetic scenes:
 
 - a result vertex is shared only by polygons of the same input face and side
-  (addon/surface_uv.py interpolates UVs per corner anyway, so a vertex with one
+  (addon/model/surface_uv.py interpolates UVs per corner anyway, so a vertex with one
   value per face side is what the "Radiosity Light" and UV data assume);
 - vertex_irradiance is the H behind the radiance: radiance = emission + rho x H
   at every vertex, with the rho and emission of its polygons' face.

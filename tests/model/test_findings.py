@@ -1,4 +1,4 @@
-"""The wording of the solver's findings (addon/findings.py) in plain Python:
+"""The wording of the solver's findings (addon/model/findings.py) in plain Python:
 the records a real Scene gives for broken faces and a SolveReuse gives for
 a solve it could not relight, worded as the panel shows them."""
 
@@ -8,10 +8,10 @@ import unittest
 
 import numpy as np
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "native"))  # synthetic_scenes
 
 import _radiosity as rad  # noqa: E402
-import findings  # noqa: E402
+from model import findings  # noqa: E402
 from synthetic_scenes import SceneBuilder, room_with_blocker  # noqa: E402
 
 

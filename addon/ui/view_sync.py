@@ -11,7 +11,7 @@ views are shaded for what the scene shows (result_state.sync_views).
 import bpy
 from bpy.app.handlers import persistent
 
-from . import result_state
+from ..write import result_state
 
 
 @persistent

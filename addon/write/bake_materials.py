@@ -21,7 +21,8 @@ textured scene renders with its textures, lit by the solution.
 import bpy
 import numpy as np
 
-from . import compat, surface_uv
+from .. import compat
+from ..model import surface_uv
 
 LIGHT_ATTRIBUTE = "Radiosity Light"
 # A lighting copy names its original material (custom property on the copy).

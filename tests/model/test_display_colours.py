@@ -1,14 +1,14 @@
-"""The game-ready colours' array math (addon/display_colours.py) in plain Python.
+"""The game-ready colours' array math (addon/model/display_colours.py) in plain Python.
 
 run_tests.py puts build/addon/radiosity on sys.path, where the build copies
-display_colours.py; it imports only numpy (PyOpenColorIO when there is one).
+model/display_colours.py; it imports only numpy (PyOpenColorIO when there is one).
 """
 
 import unittest
 
 import numpy as np
 
-import display_colours as dc
+from model import display_colours as dc
 
 
 class SrgbTest(unittest.TestCase):

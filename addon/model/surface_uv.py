@@ -1,5 +1,5 @@
 """Face-corner values (UV maps) of the input faces carried onto the refined result,
-free of `bpy` (tests: tests/native/test_surface_uv.py).
+free of `bpy` (tests: tests/model/test_surface_uv.py).
 
 Blender renders a polygon as triangles (its loop triangles) and interpolates
 face-corner data such as UVs linearly over each. A result polygon lies inside

@@ -1,6 +1,6 @@
-"""The add-on's array logic (addon/arrays.py) in plain Python: no Blender needed.
+"""The add-on's array logic (addon/model/arrays.py) in plain Python: no Blender needed.
 
-run_tests.py puts build/addon/radiosity on sys.path, where arrays.py is
+run_tests.py puts build/addon/radiosity on sys.path, where model/arrays.py is
 copied by the build; it imports only numpy.
 """
 
@@ -9,7 +9,7 @@ import unittest
 
 import numpy as np
 
-import arrays
+from model import arrays
 
 
 def polygon_area_normal(points):

@@ -31,8 +31,10 @@ from dataclasses import dataclass, field
 import bpy
 import numpy as np
 
-from . import arrays, compat, light_units, render_visibility, surface_uv
-from .result_state import HIDDEN_TAG, RESULT_TAG
+from .. import compat
+from ..model import arrays, light_units, surface_uv
+from ..write.result_state import HIDDEN_TAG, RESULT_TAG
+from . import render_visibility
 
 GEOMETRY_TYPES = {'MESH', 'CURVE', 'SURFACE', 'FONT', 'META'}
 DEFAULT_REFLECTANCE = (0.8, 0.8, 0.8)  # a face without material renders as grey 0.8 diffuse

@@ -21,9 +21,12 @@ import bpy
 from bpy.props import FloatProperty
 from bpy.types import Menu, Panel
 
-from . import compat, native, operators, pipeline, result_state, solve_reuse
-from .progress_text import progress_fraction, progress_texts
-from .quality_meaning import quality_text
+from .. import compat
+from ..model.progress_text import progress_fraction, progress_texts
+from ..model.quality_meaning import quality_text
+from ..solve import native, pipeline, solve_reuse
+from ..write import result_state
+from . import operators
 
 EDIT_WARNING = "Edits to radiosity results are replaced by the next Solve"
 SOLVING_LOCK = "The window works meanwhile; Undo, Delete and mode switches wait for the end"

@@ -1,7 +1,7 @@
 """Array logic of the scene export and the bake, free of `bpy`.
 
 Everything here takes and returns numpy arrays, so it can be tested in plain
-Python (tests/native/test_arrays.py) and stays fast: no per-vertex Python
+Python (tests/model/test_arrays.py) and stays fast: no per-vertex Python
 loops. export.py reads Blender data into these functions, bake.py writes
 their results back.
 """

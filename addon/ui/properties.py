@@ -24,7 +24,7 @@ from bpy.types import PropertyGroup
 # written into the package when it is built (solver_defaults.json): each is
 # defined once, in C++, and the settings still register when the native
 # module cannot load.
-SOLVER_DEFAULTS = json.loads(pathlib.Path(__file__).with_name("solver_defaults.json").read_text())
+SOLVER_DEFAULTS = json.loads((pathlib.Path(__file__).parent.parent / "solver_defaults.json").read_text())
 
 # Names are short enough to show uncut at the default Properties width (the
 # Blender tests measure them); descriptions say what a choice does to the
@@ -140,7 +140,7 @@ class RadiosityStats(PropertyGroup):
 
 def _update_wireframe(settings, context):
     # Imported here: bake needs bpy data that registration does not.
-    from . import bake
+    from ..write import bake
     bake.set_wireframe(settings.id_data, settings.show_wireframe)
 
 
@@ -251,7 +251,7 @@ class RadiositySettings(PropertyGroup):
         default=False,
         update=_update_wireframe,
     )
-    # Game-ready colours (issue 15; game_export.py, display_colours.py).
+    # Game-ready colours (issue 15; write/game_ready.py, model/display_colours.py).
     display_colours: BoolProperty(
         name="Game-Ready Colours",
         description=(

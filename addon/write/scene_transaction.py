@@ -12,7 +12,8 @@ previous result for good.
 
 import bpy
 
-from . import bake, bake_materials, compat, result_state
+from .. import compat
+from . import bake, bake_materials, result_state
 from .result_state import HIDDEN_TAG, ORIGINAL_ATTRIBUTE_TAG, RESULT_TAG
 
 RETIRED_SUFFIX = " (previous radiosity result)"

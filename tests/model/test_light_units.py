@@ -1,7 +1,7 @@
-"""The add-on's point, spot, sun and world conversion (addon/light_units.py) in plain Python:
+"""The add-on's point, spot, sun and world conversion (addon/model/light_units.py) in plain Python:
 no Blender needed (the measurements are tests/blender/test_light_units.py).
 
-run_tests.py puts build/addon/radiosity on sys.path, where light_units.py is copied by
+run_tests.py puts build/addon/radiosity on sys.path, where model/light_units.py is copied by
 the build; it imports only math and numpy.
 """
 
@@ -11,7 +11,7 @@ import unittest
 
 import numpy as np
 
-import light_units
+from model import light_units
 
 V3, V4, V5 = (3, 4, 1), (4, 5, 15), (5, 0, 1)
 

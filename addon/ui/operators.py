@@ -26,8 +26,10 @@ import bpy
 from bpy.app.handlers import persistent
 from bpy.types import Operator
 
-from . import bake, live_pacing, native, pipeline, result_state, solve_reuse, view_sync
-from .progress_text import status_line
+from ..model.progress_text import status_line
+from ..solve import native, pipeline, solve_reuse
+from ..write import bake, result_state
+from . import live_pacing, view_sync
 
 # The interactive solve in progress (at most one: the operator is modal), so
 # that scripts and the UI can follow it.

@@ -1,6 +1,6 @@
-"""UV maps carried onto the refined result (addon/surface_uv.py) in plain Python.
+"""UV maps carried onto the refined result (addon/model/surface_uv.py) in plain Python.
 
-run_tests.py puts build/addon/radiosity on sys.path, where surface_uv.py is
+run_tests.py puts build/addon/radiosity on sys.path, where model/surface_uv.py is
 copied by the build; it imports only numpy.
 """
 
@@ -8,7 +8,7 @@ import unittest
 
 import numpy as np
 
-import surface_uv
+from model import surface_uv
 
 
 class LoopOrderTest(unittest.TestCase):

@@ -14,6 +14,11 @@ import platform
 import re
 import sys
 
+# The add-on's package (radiosity, or bl_ext.user_default.radiosity), whose
+# folder holds the compiled modules, one per Python version.
+PACKAGE = __package__.rpartition(".")[0]
+FOLDER = pathlib.Path(__file__).resolve().parent.parent
+
 _module = None
 _error = None
 _advice = None
@@ -31,7 +36,7 @@ def load():
     global _module, _error, _advice
     if _module is None and _error is None:
         try:
-            _module = importlib.import_module("._radiosity", __package__)
+            _module = importlib.import_module("._radiosity", PACKAGE)
         except ImportError as err:
             _advice = what_to_do(source_build())
             _error = "Radiosity native module could not be loaded: %s (%s)" % (err, _advice)
@@ -43,7 +48,7 @@ def load():
 def source_build(folder=None):
     """Whether the package runs from a source build (BUILD/addon/radiosity, with
     BUILD/CMakeCache.txt) rather than from an installed zip."""
-    folder = pathlib.Path(folder or pathlib.Path(__file__).parent).resolve()
+    folder = pathlib.Path(folder or FOLDER).resolve()
     return (folder.parent.parent / "CMakeCache.txt").is_file()
 
 
@@ -76,7 +81,7 @@ def advice():
 
 
 def _version():
-    package = sys.modules.get(__package__)
+    package = sys.modules.get(PACKAGE)
     version = getattr(package, "bl_info", {}).get("version")
     return ".".join(map(str, version)) if version else "VERSION"
 
@@ -103,7 +108,7 @@ def _built_for():
     # (_radiosity.cpython-311-x86_64-linux-gnu.so), which survives a failed import;
     # the package holds one module per Python version it serves.
     versions = sorted({tuple(map(int, match.groups()))
-                       for path in pathlib.Path(__file__).parent.glob("_radiosity*.so")
+                       for path in FOLDER.glob("_radiosity*.so")
                        for match in [re.search(r"cpython-(\d)(\d+)", path.name)] if match})
     if not versions:
         return "an unknown version (no _radiosity*.so next to the add-on)"

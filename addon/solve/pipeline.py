@@ -15,7 +15,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import bake, export, findings, game_export, result_state, scene_transaction, solve_reuse
+from ..model import findings
+from ..read import export
+from ..write import bake, game_ready, result_state, scene_transaction
+from . import solve_reuse
 
 STATUS = {
     "quality": "Converged",
@@ -228,7 +231,7 @@ def bake_result(context, job, result, replace_previous):
     # Lit Materials keeps the user's materials, which no unlit material can
     # stand in for: game-ready colours apply to the other outputs.
     if settings.display_colours and mode != 'LIGHTING':
-        convert, material, note = game_export.bake_options(scene)
+        convert, material, note = game_ready.bake_options(scene)
         if note:
             warnings.append(note)
     if mode in {'REFINED', 'BOTH', 'LIGHTING'}:

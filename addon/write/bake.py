@@ -23,7 +23,9 @@
 import bpy
 import numpy as np
 
-from . import arrays, bake_materials, compat, result_state, surface_uv
+from .. import compat
+from ..model import arrays, surface_uv
+from . import bake_materials, result_state
 from .result_state import MATERIAL_TAG, ORIGINAL_ATTRIBUTE_TAG, RESULT_TAG
 
 MATERIAL_NAME = "Radiosity Emission"
@@ -116,7 +118,7 @@ def write_refined(scene, exported, result, show_wireframe=False, convert=None, m
                   lighting=False, replace_previous=None):
     """Replace the result objects by the solution's meshes. Returns the new objects.
     `convert` maps the (V, 3) radiance to the colours written and `material`
-    replaces "Radiosity Emission" (game-ready colours: game_export.bake_options).
+    replaces "Radiosity Emission" (game-ready colours: game_ready.bake_options).
     `lighting`: with lighting copies of the originals' materials (bake_materials.py)
     instead (the copies of lights' parts keep `material`). `replace_previous(scene)` takes
     the previous result away (default result_state.remove_results; a SceneTransaction retires it)."""
