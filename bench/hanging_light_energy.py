@@ -23,23 +23,10 @@ import numpy as np
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "native"))
 import _radiosity as rad  # noqa: E402
-from synthetic_scenes import SceneBuilder  # noqa: E402
+from test_energy import LAMP_RADIANCE, LAMP_SIDE, hanging_lamp_room as room  # noqa: E402
 from test_solver import absorbed_power, polygon_areas  # noqa: E402
 
-LIGHT_SIDE = 0.6
 FACES = ("floor", "ceiling", "wall -y", "wall +y", "wall -x", "wall +x", "light", "cover")
-
-
-def room(rho, gap, emission=0.0, lamp=5.0):
-    """The room, the light facing down `gap` under the ceiling and its cover facing up;
-    `emission` on every face (the furnace) or `lamp` on the light alone."""
-    b = SceneBuilder()
-    b.box((0, 0, 0), (4, 4, 3), rho=rho, emission=emission, inward=True)
-    z, lo, hi = 3.0 - gap, 2.0 - LIGHT_SIDE / 2, 2.0 + LIGHT_SIDE / 2
-    down = [(lo, lo, z), (lo, hi, z), (hi, hi, z), (hi, lo, z)]
-    b.polygon(down, rho=rho, emission=emission or lamp, two_sided=False)
-    b.polygon(down[::-1], rho=rho, emission=emission, two_sided=False)
-    return b
 
 
 def main():
@@ -57,7 +44,7 @@ def main():
                 for quality in qualities:
                     b = room(rho, gap)
                     result = rad.solve(b.scene(rad), oracle=oracle, quality=quality)
-                    ratio = absorbed_power(b, result)[0] / (math.pi * 5.0 * LIGHT_SIDE**2)
+                    ratio = absorbed_power(b, result)[0] / (math.pi * LAMP_RADIANCE * LAMP_SIDE**2)
                     print(f"| {rho} | {gap} | {oracle} | {quality} | {ratio:.5f} | {result.stats['elements']} |",
                           flush=True)
 

@@ -563,7 +563,10 @@ void bind_solver(py::module_& m) {
            py::arg("lights") = py::none(), py::arg("world") = py::none())
       .def_property_readonly("face_count", [](const Scene& s) { return s.face_count; })
       .def_property_readonly("patch_count", [](const Scene& s) { return s.patches.size(); })
-      .def_property_readonly("total_area", [](const Scene& s) { return s.total_area; })
+      .def_property_readonly(
+          "total_area",
+          [](const Scene& s) { return s.total_area / (s.frame.scale * s.frame.scale); },
+          "one side of every patch, in the input's units")
       .def_property_readonly(
           "light_count", [](const Scene& s) { return s.lights.size(); },
           "lights solved as direct light: point, spot and sun lights, and the sky")

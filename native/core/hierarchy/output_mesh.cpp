@@ -217,7 +217,7 @@ OutputMesh make_output_mesh(const Hierarchy& h,
   const auto output_vertex = [&](std::uint32_t v) {
     if (remap[v] == kNone) {
       remap[v] = static_cast<std::int32_t>(mesh.positions.size() / 3);
-      const dvec3& p = h.vertex(v);
+      const dvec3 p = h.scene().frame.to_world(h.vertex(v));
       mesh.positions.insert(mesh.positions.end(), {p.x, p.y, p.z});
       append(mesh.radiance, radiance_at(v));
       append(mesh.vertex_irradiance, gathered_at(v));
@@ -237,7 +237,8 @@ OutputMesh make_output_mesh(const Hierarchy& h,
     const dvec3 p = h.vertex(v), pa = h.vertex(a), ab = h.vertex(b) - pa;
     const double t = std::clamp(glm::dot(p - pa, ab) / glm::dot(ab, ab), 0.0, 1.0);
     const auto index = static_cast<std::int32_t>(mesh.positions.size() / 3);
-    mesh.positions.insert(mesh.positions.end(), {p.x, p.y, p.z});
+    const dvec3 world = h.scene().frame.to_world(p);
+    mesh.positions.insert(mesh.positions.end(), {world.x, world.y, world.z});
     append(mesh.radiance, (1 - t) * radiance_at(a) + t * radiance_at(b));
     append(mesh.vertex_irradiance, (1 - t) * gathered_at(a) + t * gathered_at(b));
     return index;

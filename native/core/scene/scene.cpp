@@ -260,6 +260,17 @@ void check_values(const SceneArrays& a) {
   }
 }
 
+// A light in the solver's frame: H = I cos / d^2 keeps its value as d scales
+// when I scales with d^2; a sun's or the sky's H has no length in it.
+Light in_frame(Light light, const SolverFrame& frame) {
+  if (light.kind == LightKind::Point || light.kind == LightKind::Spot) {
+    light.position = frame.to_solver(light.position);
+    light.radius *= frame.scale;
+    light.colour *= frame.scale * frame.scale;
+  }
+  return light;
+}
+
 }  // namespace
 
 std::string_view face_issue_name(FaceIssue issue) {
@@ -295,33 +306,40 @@ Scene make_scene(const SceneArrays& a) {
   Scene scene;
   scene.face_count = a.face_sizes.size();
   scene.vertex_count = a.positions.size() / 3;
-  const auto vertex = [&](std::int64_t i) {
+  const auto world_vertex = [&](std::int64_t i) {
     const size_t k = static_cast<size_t>(i) * 3;
     return dvec3(a.positions[k], a.positions[k + 1], a.positions[k + 2]);
   };
   dvec3 lo(1e300), hi(-1e300);
   for (size_t v = 0; v < scene.vertex_count; ++v) {
-    lo = glm::min(lo, vertex(static_cast<std::int64_t>(v)));
-    hi = glm::max(hi, vertex(static_cast<std::int64_t>(v)));
+    lo = glm::min(lo, world_vertex(static_cast<std::int64_t>(v)));
+    hi = glm::max(hi, world_vertex(static_cast<std::int64_t>(v)));
   }
-  scene.diameter = glm::length(hi - lo);
-  if (!(scene.diameter >= kMinSceneSize)) {
+  const double world_diameter = glm::length(hi - lo);
+  if (!(world_diameter >= kMinSceneSize)) {
     std::ostringstream m;
-    m << "the scene is " << scene.diameter << " across; scenes smaller than " << kMinSceneSize
+    m << "the scene is " << world_diameter << " across; scenes smaller than " << kMinSceneSize
       << " cannot be solved (scale the scene up)";
     fail(m.str());
   }
   const double reach = std::max(glm::length(lo), glm::length(hi));
-  if (!(scene.diameter >= kMinRelativeSize * reach)) {
+  if (!(world_diameter >= kMinRelativeSize * reach)) {
     std::ostringstream m;
-    m << "the scene is " << scene.diameter << " across but " << reach
+    m << "the scene is " << world_diameter << " across but " << reach
       << " from the origin: too far for its size to be solved precisely (move it to the origin)";
     fail(m.str());
   }
+  scene.frame.origin = 0.5 * (lo + hi);
+  scene.frame.scale = std::exp2(-std::ceil(std::log2(world_diameter)));
+  scene.diameter = world_diameter * scene.frame.scale;
+  const auto vertex = [&](std::int64_t i) { return scene.frame.to_solver(world_vertex(i)); };
+  // A length in the solver's frame as the user measures it, for messages and notes.
+  const auto in_world = [&](double length) { return length / scene.frame.scale; };
 
-  // Faces too small to solve in floating point (scene.h).
-  const double smallest_face =
-      std::max(kMinRelativeFaceSize * scene.diameter, kMinFaceSizeOfReach * reach);
+  // Faces too small to solve in floating point (scene.h): the input's
+  // coordinates carry their rounding at `reach` from the origin.
+  const double smallest_face = std::max(kMinRelativeFaceSize * scene.diameter,
+                                        kMinFaceSizeOfReach * reach * scene.frame.scale);
   size_t offset = 0;
   std::vector<dvec3> polygon;
   std::vector<std::array<size_t, 3>> triangles;
@@ -356,8 +374,8 @@ Scene make_scene(const SceneArrays& a) {
     if (diameter < smallest_face) {
       scene.skipped.push_back({.face = face,
                                .issue = FaceIssue::TooSmall,
-                               .size = diameter,
-                               .scene_size = scene.diameter});
+                               .size = in_world(diameter),
+                               .scene_size = world_diameter});
       continue;
     }
     std::vector<FaceNote> repairs;
@@ -409,7 +427,7 @@ Scene make_scene(const SceneArrays& a) {
   }
   for (size_t i = 0; i < a.lights.size(); ++i) check_light(a.lights[i], i);
   for (const Light& light : a.lights)
-    if (luminance(light.colour) > 0.0) scene.lights.push_back(light);
+    if (luminance(light.colour) > 0.0) scene.lights.push_back(in_frame(light, scene.frame));
   for (int c = 0; c < 3; ++c) {
     if (!(a.world[c] >= 0.0 && a.world[c] <= kMaxInputRadiance)) {
       std::ostringstream m;

@@ -131,10 +131,15 @@ void EnergyBalance::update(const Hierarchy& h, const LinkGather& grouping, const
   const auto& elements = h.elements();
   const size_t n = elements.size();
   // Coverage, the form factors of every sample's links summed (its
-  // ancestors' pushed down): x of all linked emitters, y of those that
-  // receive too (reflect).
+  // ancestors' pushed down): x of all linked emitters that take up part of
+  // the hemisphere (a lamp that casts no shadow, as Blender's lights, hides
+  // nothing: what lies behind it is linked too), y of those that receive too
+  // (reflect).
   std::vector<Rgb> partners(n);
-  for (size_t e = 0; e < n; ++e) partners[e] = Rgb(1.0, reflects(h, elements[e]) ? 1.0 : 0.0, 0.0);
+  for (size_t e = 0; e < n; ++e) {
+    const bool opaque = h.patch_of(elements[e]).occludes;
+    partners[e] = Rgb(opaque ? 1.0 : 0.0, reflects(h, elements[e]) ? 1.0 : 0.0, 0.0);
+  }
   const LinkGather coverage{grouping.hierarchy, grouping.links, grouping.offset, grouping.order,
                             partners};
   std::vector<SampleRgb> far_coverage;
@@ -188,7 +193,10 @@ void EnergyBalance::update(const Hierarchy& h, const LinkGather& grouping, const
     for (size_t e = range.begin(); e != range.end(); ++e) {
       const Element& x = elements[e];
       if (!x.is_leaf() || !x.has_links) continue;
-      const bool closed = closed_root[2 * static_cast<size_t>(x.patch) + x.side] != 0;
+      const size_t slot = 2 * static_cast<size_t>(x.patch) + x.side;
+      const bool closed = closed_root[slot] != 0;
+      const auto root = static_cast<size_t>(h.root(x.patch, x.side));
+      const bool enclosed = root < enclosed_.size() && enclosed_[root] != 0;
       const SampleRgb own = coverage(static_cast<std::int32_t>(e));
       SampleRgb received{};
       for (int s = 0; s < x.sample_count(); ++s) {
@@ -201,9 +209,11 @@ void EnergyBalance::update(const Hierarchy& h, const LinkGather& grouping, const
         down_scale_[e][k] = static_cast<float>(scale);
         received[k] = own[k] + scale * down;
       }
+      const Rgb mean = Interpolant::average(x.corner_count, received);
       // At most the whole hemisphere: where the samples say more, it is the
       // energy correction of a link (link_transport) showing at a point.
-      receiving[e] = std::min(1.0, Interpolant::average(x.corner_count, received).y);
+      receiving[e] =
+          enclosed ? std::clamp(1.0 - (mean.x - mean.y), 0.0, 1.0) : std::min(1.0, mean.y);
     }
   });
 

@@ -38,10 +38,22 @@
 // area average of their leaves. Surfaces that reflect nothing are not
 // balanced on either side: they have no receiver links to know a closure by,
 // and an emitter's own light is uniform.
+//
+// Closure from the scene. The links' form factors at a point do not sum to
+// exactly its closure: each link carries the exact exchange of its two
+// elements, so its values at the samples lean (a corner of a ceiling a
+// centimetre above a lamp's cover sums to 0.95, a wall's corners to 0.96 to
+// 1.01). Taken as C_l, that shortfall is light lost at every bounce (1 % of
+// the power at rho = 0.9, 11 % at 0.99, in a closed room with a lamp under
+// its ceiling). Where the ray pass saw every ray from a top-level element meet
+// a surface (set_enclosed), nothing leaves its hemisphere, and C_l is 1 less
+// the share its links give to surfaces that do not reflect. Conservation then
+// holds by construction: every leaf delivers what it sends.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "core/hierarchy/cluster_tree.h"
@@ -60,6 +72,11 @@ class EnergyBalance {
   void update(const Hierarchy& hierarchy, const LinkGather& grouping, const ClusterTree& tree,
               const std::vector<ClusterLink>& far, ClusterGather& far_gather);
 
+  // Per top-level element (indexed by element id, as RayPass::enclosed): 1
+  // where nothing escapes its hemisphere. Kept across updates; empty (no
+  // element known enclosed) until the ray pass has run.
+  void set_enclosed(std::vector<std::uint8_t> enclosed) { enclosed_ = std::move(enclosed); }
+
   // Per element, the factor on what each leaf sample receives from its
   // ancestors (push_pull's `down_scale`); empty before the first update.
   const std::vector<SampleScale>& down_scale() const { return down_scale_; }
@@ -74,6 +91,7 @@ class EnergyBalance {
   std::vector<SampleScale> down_scale_;  // per element (leaves), at its samples
   std::vector<float> leaf_scale_;  // C_l / D_l per element (1 where not balanced or not a leaf)
   std::vector<float> root_scale_;  // lambda per root slot (2 patch + side)
+  std::vector<std::uint8_t> enclosed_;  // per top-level element id
 };
 
 }  // namespace radiosity

@@ -19,6 +19,9 @@ namespace {
 
 constexpr double kTolerance = 1e-4;  // relative change of the total radiance
 constexpr int kMaxIterations = 1000;
+// How far toward the element's centre an escaped ray is tried again before
+// the element is taken to see an opening (RayPass::enclosed).
+constexpr double kInset = 0.01;
 
 // Every patch, the lights' too (a ray that meets a lamp takes its emission),
 // tagged with its patch index.
@@ -158,6 +161,7 @@ RayPass ray_pass(const Hierarchy& hierarchy, const RayScene& occluders,
   RayPass pass;
   pass.rays = ray_pass_rays(reflecting);
   pass.gathered.assign(count, Rgb(0.0));
+  pass.enclosed.assign(count, 0);
   const auto rays = static_cast<std::size_t>(pass.rays);
   // Per element: the direct light of emitters, lights and sky (fixed), and
   // the top-level element each cosine ray meets (kNone: the sky, or the back
@@ -167,6 +171,19 @@ RayPass ray_pass(const Hierarchy& hierarchy, const RayScene& occluders,
   const Emitters emitters(hierarchy, root_element);
   const RayScene tracer = patch_rays(scene);
   const double reach = 2.0 * std::max(scene.diameter, 1e-300);
+  // Does the ray from `from` along `w` end on a side that has an element?
+  const auto meets_element = [&](const dvec3& from, const dvec3& w, std::uint32_t skip) {
+    float along = 1.0f;
+    const std::uint32_t p = tracer.first_hit(from, from + reach * w, skip, along);
+    return p != kNoFace &&
+           hierarchy.root(p, glm::dot(w, scene.patches[p].normal) < 0.0 ? 0 : 1) != kNone;
+  };
+  // A lamp that casts no shadow (Blender's lights) hides nothing behind its
+  // back: the ray goes on past it.
+  const auto through_lamp_meets_element = [&](const dvec3& from, const dvec3& w,
+                                              std::uint32_t lamp) {
+    return !scene.patches[lamp].occludes && meets_element(from, w, lamp);
+  };
   std::atomic<bool> stop{false};
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, root_element.size(), 16), [&](const auto& range) {
@@ -182,9 +199,13 @@ RayPass ray_pass(const Hierarchy& hierarchy, const RayScene& occluders,
           dvec3 corner[4];
           hierarchy.corners(e, corner);
           const dvec3 n = hierarchy.normal(e);
+          dvec3 centre(0.0);
+          for (int c = 0; c < e.corner_count; ++c)
+            centre += corner[c] / static_cast<double>(e.corner_count);
           const std::uint32_t surface = hierarchy.patch_of(e).surface;
           SplitMix64 random{0x5EEDull * static_cast<std::uint64_t>(id + 1)};
           Rgb direct(0.0);
+          bool enclosed = true;
           for (std::size_t k = 0; k < rays; ++k) {
             const dvec3 x = point_on(corner, e.corner_count, random);
             for (const Light& light : scene.lights)
@@ -211,12 +232,18 @@ RayPass ray_pass(const Hierarchy& hierarchy, const RayScene& occluders,
             const std::uint32_t p = tracer.first_hit(x, x + reach * w, e.patch, along);
             if (p == kNoFace) {
               direct += sky;
+              // A ray from within the segments' margin of a surface the element
+              // meets at an edge (a ceiling's point beside a wall) slips past
+              // it: an opening is where a ray leaves from inside the element too.
+              const dvec3 inside = x + kInset * (centre - x);
+              enclosed &= meets_element(inside, w, e.patch);
               continue;
             }
             const dvec3 normal_p = scene.patches[p].normal;
             const int side = glm::dot(w, normal_p) < 0.0 ? 0 : 1;
             const std::int32_t hit = hierarchy.root(p, side);
             met[at * rays + k] = hit;
+            enclosed &= hit != kNone || through_lamp_meets_element(x, w, p);
             if (hit == kNone || emitters.element.empty()) continue;
             const Element& q = hierarchy.element(hit);
             if (!(luminance(hierarchy.emission(q)) > 0.0)) continue;
@@ -227,6 +254,7 @@ RayPass ray_pass(const Hierarchy& hierarchy, const RayScene& occluders,
             direct += hierarchy.emission(q) * power_heuristic(by_ray, by_point);
           }
           fixed[at] = direct / static_cast<double>(rays);
+          pass.enclosed[at] = enclosed ? 1 : 0;
         }
       });
   if (stop) return pass;

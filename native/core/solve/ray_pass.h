@@ -36,6 +36,11 @@ struct RayPass {
   // Per top-level element (they are the first elements): what it gathers (H)
   // from emitters, lights, sky and reflecting surfaces, uniform over it.
   std::vector<Rgb> gathered;
+  // Per top-level element that reflects: 1 where every cosine ray met a side
+  // of a patch that has an element (nothing escaped to the sky or met the back
+  // of a one-sided face): the surroundings close around it, so its closure is
+  // 1 (energy_balance.h).
+  std::vector<std::uint8_t> enclosed;
   int rays = 0;        // per reflecting top-level element
   int iterations = 0;  // Jacobi iterations
   bool complete = false;

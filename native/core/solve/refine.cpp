@@ -73,6 +73,9 @@ bool near_field(const Hierarchy& hierarchy, const Link& link, bool receiver_end)
 
 namespace {
 
+// Areas this close are the same area (rounding of the input's coordinates).
+constexpr double kSameArea = 1e-9;
+
 // A light: at least 90 % of its radiance emitted (with half, the furnace's
 // emitting walls counted as lights and came out 1.0e-3 off next to their edges).
 bool is_light(const Hierarchy& hierarchy, const Element& e) {
@@ -123,9 +126,12 @@ Split choose_split(const Hierarchy& hierarchy, const Link& link, double threshol
   // link carries, only how the same error is shared out among four links:
   // links from lights split their receiver first. From reflecting surfaces,
   // whose radiance varies, the larger end, as the others.
+  // Equal areas (opposite walls, their children) compare to within rounding:
+  // the receiver goes first, so that the choice does not turn on the last bit
+  // of the input (the same scene in millimetres linked differently).
   const bool receiver_first =
-      p.area >= q.area || (scale.oracle == Oracle::Noticeable && from_light &&
-                           limits.can_split(hierarchy, link.receiver));
+      p.area >= q.area * (1.0 - kSameArea) || (scale.oracle == Oracle::Noticeable && from_light &&
+                                               limits.can_split(hierarchy, link.receiver));
   const std::int32_t first = receiver_first ? link.receiver : link.emitter;
   const std::int32_t second = receiver_first ? link.emitter : link.receiver;
   if (limits.can_split(hierarchy, first)) return receiver_first ? Split::Receiver : Split::Emitter;

@@ -269,7 +269,7 @@ std::vector<Link> Solver::evaluate(std::vector<Link>&& candidates) {
 // flags are set for the output mesh only and cleared again.
 void Solver::look_by_rays() {
   const auto start = Clock::now();
-  const RayPass pass =
+  RayPass pass =
       ray_pass(hierarchy_, *occluders_.rays, [this] { return cancelled() || out_of_time(); });
   stats_.ray_pass_rays = pass.complete ? pass.rays : 0;
   if (pass.complete) {
@@ -286,6 +286,7 @@ void Solver::look_by_rays() {
     shown.iterations = pass.iterations;
     result_.stats = shown;
   }
+  if (pass.complete) balance_.set_enclosed(std::move(pass.enclosed));
   stats_.seconds_ray_pass = seconds_since(start);
   if (pass.complete) report(SolvePhase::Linking, 0.0, &result_);  // shown while linking runs
 }

@@ -68,6 +68,18 @@ struct PatchSide {
   Rgb emission{0.0};
 };
 
+// Where the solver works: a scene's positions centred on its bounding box and
+// scaled so that its diameter is between 0.5 and 1, by a power of two (so the
+// scaling rounds nothing). Every tolerance of the solver, and the float32
+// geometry of the ray tracer, is then the same for a scene modelled in
+// millimetres or kilometres, at the origin or 10 km from it.
+struct SolverFrame {
+  dvec3 origin{0.0};
+  double scale = 1.0;
+  dvec3 to_solver(const dvec3& world) const { return (world - origin) * scale; }
+  dvec3 to_world(const dvec3& solver) const { return solver / scale + origin; }
+};
+
 // A planar, convex piece of surface: the top of the element hierarchy.
 struct Patch {
   std::array<dvec3, 4> corners{};  // counter-clockwise about `normal`
@@ -110,7 +122,7 @@ struct FaceNote {
   std::uint32_t face;
   FaceIssue issue;
   std::uint32_t count = 0;  // RepeatedCorners: corners removed; NotPlanar: triangles made
-  // TooSmall: the face's diameter and the scene's; NotPlanar: the corners'
+  // TooSmall: the face's diameter and the scene's, in the input's units; NotPlanar: the corners'
   // largest distance from the face's plane as a fraction of its diameter.
   double size = 0.0;
   double scene_size = 0.0;
@@ -120,7 +132,9 @@ struct FaceNote {
 // How many faces `notes` (in face order, as Scene lists them) concern.
 std::size_t noted_faces(std::span<const FaceNote> notes);
 
+// Every length, area and light in the solver's frame (`frame`).
 struct Scene {
+  SolverFrame frame;
   std::vector<Patch> patches;
   // What casts shadows: the faces' own planar pieces before contact.h split
   // them (a cut line must not be a crack light can slip through), without
