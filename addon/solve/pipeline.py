@@ -1,11 +1,11 @@
 """A solve without its UI: settings -> native options, export -> solve -> bake.
 
-The operator (operators.py) calls these in order. `prepare` exports the scene
+The operator (ui/operators.py) calls these in order. `prepare` exports the scene
 and makes the native Scene and the solver's options (main thread); the native
 solve runs in `solve` (on the calling thread) or in `work` (on a worker thread:
 it touches no bpy, and the native solve releases the GIL); `conclude` (main
 thread) turns the job's error into a SolveError or `finish`es: bakes the result
-in one transaction (scene_transaction.py) and writes the statistics into
+in one transaction (write/scene_transaction.py) and writes the statistics into
 scene.radiosity.stats. Failures the user can act on raise SolveError, whose
 message is reported as is; a failure leaves the scene as it was.
 """

@@ -19,6 +19,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 
+import radiosity
 from radiosity.model import display_colours
 from radiosity.write import bake, game_ready, result_state
 
@@ -27,8 +28,8 @@ sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..",
 import build_scene  # noqa: E402
 import gltf_validator  # noqa: E402
 
-# build/addon/radiosity/bake.py -> build
-BUILD = Path(bake.__file__).resolve().parents[2]
+# build/addon/radiosity/__init__.py -> build
+BUILD = Path(radiosity.__file__).resolve().parents[2]
 TMP = tempfile.mkdtemp(prefix="radiosity-gltf-")
 LIGHT = 12.0  # the cube scene's light radiance (scenes/cube.py)
 

@@ -18,6 +18,7 @@ import unittest
 import bpy
 import numpy as np
 
+import radiosity
 from radiosity.solve import native, pipeline, solve_reuse
 from radiosity.ui import operators
 from radiosity.write import bake, result_state
@@ -27,7 +28,7 @@ import build_scene  # noqa: E402
 import catalog  # noqa: E402
 from test_addon import scene_snapshot  # noqa: E402
 
-ADDON_DIR = os.path.dirname(os.path.dirname(os.path.abspath(bake.__file__)))
+ADDON_DIR = os.path.dirname(os.path.dirname(os.path.abspath(radiosity.__file__)))  # build/addon
 TMP = tempfile.mkdtemp(prefix="radiosity-test-")
 
 
