@@ -23,7 +23,8 @@ import numpy as np
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "native"))
 import _radiosity as rad  # noqa: E402
-from test_energy import LAMP_RADIANCE, LAMP_SIDE, hanging_lamp_room as room  # noqa: E402
+from test_hanging_lamp import LAMP_SIDE, hanging_lamp_room as room  # noqa: E402
+from test_energy import LAMP_RADIANCE  # noqa: E402
 from test_solver import absorbed_power, polygon_areas  # noqa: E402
 
 FACES = ("floor", "ceiling", "wall -y", "wall +y", "wall -x", "wall +x", "light", "cover")

@@ -71,7 +71,9 @@ NATIVE_ONCE = {
     "test_image_metric.py": "the study's _image_metric is built for Debian's Python alone",
     "test_solver.py": "the solver's numerics", "test_energy.py": "the solver's energy balance",
     "test_contact.py": "the solver's contact meshing", "test_format.py": "the C++ sources' format",
-    "test_rough_look.py": "the ray pass's numerics",
+    "test_rough_look.py": "the ray pass's numerics", "test_units.py": "the solver's frame",
+    "test_hanging_lamp.py": "the solver's energy balance",
+    "test_extremes.py": "the solver at the extremes",
 }
 # The package-level check of a --check-blender Blender.
 PACKAGE_CHECK = {"test_package.py"}
@@ -79,6 +81,8 @@ PACKAGE_CHECK = {"test_package.py"}
 # Wine in three Windows CPythons, 3.11's with the numerics files, and Windows Blender
 # 4.5 four times: 879 to 1015 s here on two shared cores, README "Windows and macOS").
 PLATFORMS_TIMEOUT = 7200
+# Files that take longer than --timeout by design, with theirs (seconds).
+LONG_FILES = {"native/test_hanging_lamp.py": 2400}
 LOG_TAIL = 80  # lines of a crashed process' output worth showing
 
 
@@ -201,6 +205,13 @@ def run_ctest(build, patterns, timeout, verbose):
 
 
 # --- Python test files ---------------------------------------------------------------
+
+def file_timeout(name, timeout):
+    """Seconds before the process of test file `name` counts as hung."""
+    if name.startswith("platforms/"):
+        return max(timeout, PLATFORMS_TIMEOUT)
+    return max(timeout, LONG_FILES.get(name, 0))
+
 
 def run_unittest_file(name, cmd, json_out, timeout, verbose):
     """Run one file through unittest_runner.py and read its JSON report."""
@@ -363,8 +374,7 @@ def main():
         jobs = python_jobs(args, build, tmp)
         with concurrent.futures.ThreadPoolExecutor(max(1, args.jobs)) as pool:
             futures = [(label, pool.submit(run_unittest_file, name, cmd, json_out,
-                                           max(args.timeout, PLATFORMS_TIMEOUT) if name.startswith("platforms/")
-                                           else args.timeout, args.verbose))
+                                           file_timeout(name, args.timeout), args.verbose))
                        for name, label, cmd, json_out in jobs]
             for label, future in futures:  # in a fixed order, whatever finishes first
                 outcome = future.result()

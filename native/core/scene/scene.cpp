@@ -330,7 +330,7 @@ Scene make_scene(const SceneArrays& a) {
     fail(m.str());
   }
   scene.frame.origin = 0.5 * (lo + hi);
-  scene.frame.scale = std::exp2(-std::ceil(std::log2(world_diameter)));
+  scene.frame.scale = 1.0 / world_diameter;
   scene.diameter = world_diameter * scene.frame.scale;
   const auto vertex = [&](std::int64_t i) { return scene.frame.to_solver(world_vertex(i)); };
   // A length in the solver's frame as the user measures it, for messages and notes.

@@ -26,6 +26,10 @@ constexpr double kMinDownCoverage = 0.05;
 // correct (correcting to its interpolation made an open Cornell box 4 % too
 // bright).
 constexpr double kClosed = 1.0 - 1e-3;
+// Up to this share of escaping rays the ray pass's closure of a top-level
+// element is blended in (set_escaped); beyond, its leaves' closure varies too
+// much over it (a wall beside a window) for one number.
+constexpr double kTrustRays = 0.1;
 
 bool reflects(const Hierarchy& h, const Element& e) { return luminance(h.reflectance(e)) > 0.0; }
 
@@ -196,7 +200,9 @@ void EnergyBalance::update(const Hierarchy& h, const LinkGather& grouping, const
       const size_t slot = 2 * static_cast<size_t>(x.patch) + x.side;
       const bool closed = closed_root[slot] != 0;
       const auto root = static_cast<size_t>(h.root(x.patch, x.side));
-      const bool enclosed = root < enclosed_.size() && enclosed_[root] != 0;
+      // How far the rays' closure is trusted over the links' (1: nothing escapes).
+      const double escaped = root < escaped_.size() ? static_cast<double>(escaped_[root]) : 1.0;
+      const double trust = std::clamp(1.0 - escaped / kTrustRays, 0.0, 1.0);
       const SampleRgb own = coverage(static_cast<std::int32_t>(e));
       SampleRgb received{};
       for (int s = 0; s < x.sample_count(); ++s) {
@@ -212,8 +218,8 @@ void EnergyBalance::update(const Hierarchy& h, const LinkGather& grouping, const
       const Rgb mean = Interpolant::average(x.corner_count, received);
       // At most the whole hemisphere: where the samples say more, it is the
       // energy correction of a link (link_transport) showing at a point.
-      receiving[e] =
-          enclosed ? std::clamp(1.0 - (mean.x - mean.y), 0.0, 1.0) : std::min(1.0, mean.y);
+      receiving[e] = trust * std::clamp(1.0 - (mean.x - mean.y) - escaped, 0.0, 1.0) +
+                     (1.0 - trust) * std::min(1.0, mean.y);
     }
   });
 

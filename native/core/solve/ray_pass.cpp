@@ -20,7 +20,7 @@ namespace {
 constexpr double kTolerance = 1e-4;  // relative change of the total radiance
 constexpr int kMaxIterations = 1000;
 // How far toward the element's centre an escaped ray is tried again before
-// the element is taken to see an opening (RayPass::enclosed).
+// the element is taken to see an opening (RayPass::escaped).
 constexpr double kInset = 0.01;
 
 // Every patch, the lights' too (a ray that meets a lamp takes its emission),
@@ -161,7 +161,7 @@ RayPass ray_pass(const Hierarchy& hierarchy, const RayScene& occluders,
   RayPass pass;
   pass.rays = ray_pass_rays(reflecting);
   pass.gathered.assign(count, Rgb(0.0));
-  pass.enclosed.assign(count, 0);
+  pass.escaped.assign(count, 0.0f);
   const auto rays = static_cast<std::size_t>(pass.rays);
   // Per element: the direct light of emitters, lights and sky (fixed), and
   // the top-level element each cosine ray meets (kNone: the sky, or the back
@@ -205,7 +205,7 @@ RayPass ray_pass(const Hierarchy& hierarchy, const RayScene& occluders,
           const std::uint32_t surface = hierarchy.patch_of(e).surface;
           SplitMix64 random{0x5EEDull * static_cast<std::uint64_t>(id + 1)};
           Rgb direct(0.0);
-          bool enclosed = true;
+          std::size_t escaped = 0;
           for (std::size_t k = 0; k < rays; ++k) {
             const dvec3 x = point_on(corner, e.corner_count, random);
             for (const Light& light : scene.lights)
@@ -236,14 +236,14 @@ RayPass ray_pass(const Hierarchy& hierarchy, const RayScene& occluders,
               // meets at an edge (a ceiling's point beside a wall) slips past
               // it: an opening is where a ray leaves from inside the element too.
               const dvec3 inside = x + kInset * (centre - x);
-              enclosed &= meets_element(inside, w, e.patch);
+              escaped += meets_element(inside, w, e.patch) ? 0 : 1;
               continue;
             }
             const dvec3 normal_p = scene.patches[p].normal;
             const int side = glm::dot(w, normal_p) < 0.0 ? 0 : 1;
             const std::int32_t hit = hierarchy.root(p, side);
             met[at * rays + k] = hit;
-            enclosed &= hit != kNone || through_lamp_meets_element(x, w, p);
+            escaped += hit != kNone || through_lamp_meets_element(x, w, p) ? 0 : 1;
             if (hit == kNone || emitters.element.empty()) continue;
             const Element& q = hierarchy.element(hit);
             if (!(luminance(hierarchy.emission(q)) > 0.0)) continue;
@@ -254,7 +254,8 @@ RayPass ray_pass(const Hierarchy& hierarchy, const RayScene& occluders,
             direct += hierarchy.emission(q) * power_heuristic(by_ray, by_point);
           }
           fixed[at] = direct / static_cast<double>(rays);
-          pass.enclosed[at] = enclosed ? 1 : 0;
+          pass.escaped[at] =
+              static_cast<float>(static_cast<double>(escaped) / static_cast<double>(rays));
         }
       });
   if (stop) return pass;

@@ -36,11 +36,11 @@ struct RayPass {
   // Per top-level element (they are the first elements): what it gathers (H)
   // from emitters, lights, sky and reflecting surfaces, uniform over it.
   std::vector<Rgb> gathered;
-  // Per top-level element that reflects: 1 where every cosine ray met a side
-  // of a patch that has an element (nothing escaped to the sky or met the back
-  // of a one-sided face): the surroundings close around it, so its closure is
-  // 1 (energy_balance.h).
-  std::vector<std::uint8_t> enclosed;
+  // Per top-level element that reflects: the share of its cosine rays that
+  // met no side of a patch that has an element (they left for the sky or met
+  // the back of a one-sided face): 0 where the surroundings close around it
+  // (energy_balance.h).
+  std::vector<float> escaped;
   int rays = 0;        // per reflecting top-level element
   int iterations = 0;  // Jacobi iterations
   bool complete = false;

@@ -286,7 +286,7 @@ void Solver::look_by_rays() {
     shown.iterations = pass.iterations;
     result_.stats = shown;
   }
-  if (pass.complete) balance_.set_enclosed(std::move(pass.enclosed));
+  if (pass.complete) balance_.set_escaped(std::move(pass.escaped));
   stats_.seconds_ray_pass = seconds_since(start);
   if (pass.complete) report(SolvePhase::Linking, 0.0, &result_);  // shown while linking runs
 }

@@ -69,10 +69,12 @@ struct PatchSide {
 };
 
 // Where the solver works: a scene's positions centred on its bounding box and
-// scaled so that its diameter is between 0.5 and 1, by a power of two (so the
-// scaling rounds nothing). Every tolerance of the solver, and the float32
+// scaled to a diameter of 1. Every tolerance of the solver, and the float32
 // geometry of the ray tracer, is then the same for a scene modelled in
-// millimetres or kilometres, at the origin or 10 km from it.
+// millimetres or kilometres, at the origin or 10 km from it (scaled by a
+// power of two instead, to round nothing, the scene in millimetres came out
+// 2.4 % larger than in metres, and a spot light's room refined to 25 % more
+// elements and 1.2 % less light: some length in the solver is still absolute).
 struct SolverFrame {
   dvec3 origin{0.0};
   double scale = 1.0;

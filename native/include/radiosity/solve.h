@@ -51,7 +51,11 @@ enum class Oracle : std::uint8_t {
 enum class VisibilityMode : std::uint8_t { Exact, Sampled };
 
 struct SolveOptions {
-  Oracle oracle = Oracle::Perceptual;
+  // Noticeable reaches a given error soonest (the study: 0.21 to 0.73 times
+  // the standard oracle's time at equal DoG error, perceptual 0.82 to 2.36),
+  // and keeps its brightness at coarse meshes: a closed textured room at
+  // quality 0.5 came out -0.2 % from Cycles in exposure, perceptual +3.8 %.
+  Oracle oracle = Oracle::Noticeable;
   // 0 = no refinement (the coarsest solution), 1 = the finest the oracle's
   // threshold scale allows; see quality_threshold().
   double quality = 0.5;
