@@ -362,6 +362,12 @@ void Solver::link_initially() {
 // and the receivers of light links and spreads through the links, from
 // emitter to receiver; cluster links count as reaching every side of their
 // receiving cluster.
+// A link whose form factor is below this at every sample reaches its receiver
+// through a crack that rounding opens (the inside of a closed box saw the room
+// through its edges at 4e-10 once the scene was scaled to the solver's frame),
+// not through a gap in the geometry.
+constexpr float kCrack = 1e-9f;
+
 void Solver::drop_links_light_cannot_reach() {
   const size_t sides = hierarchy_.root_count();
   std::vector<std::uint8_t> reached(hierarchy_.elements().size(), 0);
@@ -376,7 +382,8 @@ void Solver::drop_links_light_cannot_reach() {
   for (bool spread = true; spread;) {
     spread = false;
     for (const Link& l : links_) {
-      if (reached[static_cast<size_t>(l.emitter)] && !reached[static_cast<size_t>(l.receiver)]) {
+      if (reached[static_cast<size_t>(l.emitter)] && !reached[static_cast<size_t>(l.receiver)] &&
+          *std::max_element(l.form_factor.begin(), l.form_factor.end()) > kCrack) {
         reached[static_cast<size_t>(l.receiver)] = 1;
         spread = true;
       }
