@@ -67,7 +67,8 @@ class PackageChecks:
     """What every platform's zip is checked for (mixed into an UnpackedZip)."""
 
     def test_zips_hold_the_addon_and_one_module_per_python(self):
-        python_files = sorted(p.name for p in ADDON.glob("*.py"))
+        python_files = sorted(p.relative_to(ADDON).as_posix() for p in ADDON.rglob("*.py")
+                              if "__pycache__" not in p.parts)  # the sub-packages too
         prefix = package.FOLDER  # one folder: the add-on in 3.x, the extension in 4.2+
         with zipfile.ZipFile(zip_path(self.PLATFORM)) as zf:
             names = zf.namelist()
