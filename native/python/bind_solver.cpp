@@ -599,14 +599,15 @@ void bind_solver(py::module_& m) {
             for (const Patch& p : s.patches) {
               py::list corners;
               for (int k = 0; k < p.corner_count; ++k) {
-                const dvec3& c = p.corners[static_cast<size_t>(k)];
+                const dvec3 c = s.frame.to_world(p.corners[static_cast<size_t>(k)]);
                 corners.append(py::make_tuple(c.x, c.y, c.z));
               }
               py::list sides;
               for (const PatchSide& side : p.sides)
                 sides.append(side.present ? py::object(py::make_tuple(side.face, side.face_side))
                                           : py::object(py::none()));
-              out.append(py::dict(py::arg("corners") = corners, py::arg("area") = p.area,
+              const double area = p.area / (s.frame.scale * s.frame.scale);
+              out.append(py::dict(py::arg("corners") = corners, py::arg("area") = area,
                                   py::arg("sides") = sides));
             }
             return out;

@@ -30,8 +30,10 @@ TEST(Hierarchy, OnlyElementsTouchingAnInsetEdgeSampleFurtherIn) {
     const Element& child = h.element(c);
     dvec3 corners[4];
     h.corners(child, corners);
+    // In the input's units: the scene works in its own frame (scene.h).
     bool on_edge = false;
-    for (int k = 0; k < child.corner_count; ++k) on_edge |= corners[k].y == 0.0;
+    for (int k = 0; k < child.corner_count; ++k)
+      on_edge |= scene.frame.to_world(corners[k]).y == 0.0;
     EXPECT_EQ(h.samples_inset(child), on_edge) << c;
     touching += on_edge ? 1 : 0;
 
@@ -39,7 +41,8 @@ TEST(Hierarchy, OnlyElementsTouchingAnInsetEdgeSampleFurtherIn) {
     dvec3 x[kMaxSamples];
     h.samples(child, x);
     double lowest = 1.0;
-    for (int k = 0; k < child.corner_count; ++k) lowest = std::min(lowest, x[k].y);
+    for (int k = 0; k < child.corner_count; ++k)
+      lowest = std::min(lowest, scene.frame.to_world(x[k]).y);
     if (on_edge) {
       EXPECT_GT(lowest, 1e-3);
     }

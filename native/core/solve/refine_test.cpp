@@ -117,12 +117,14 @@ TEST(ChooseSplit, NoticeableSplitsAnUnevenEmitterItsReceiverSeesEvenly) {
 
 TEST(ChooseSplit, NothingBelowTheSmallestElement) {
   const FloorAndLamp s(1.0, 0.5, 1.0);
-  // The floor's children would be 0.25, the lamp's 0.0625.
+  // The floor's children would be 0.25, the lamp's 0.0625 (in the input's
+  // units; the limits are areas in the solver's frame, scene.h).
+  const double to_frame = s.h.scene().frame.scale * s.h.scene().frame.scale;
   EXPECT_EQ(choose_split(s.h, s.link(1.0f), 0.1, DecisionScale{Oracle::Standard, 1.0},
-                         RefineLimits{0.3, {}}),
+                         RefineLimits{0.3 * to_frame, {}}),
             Split::None);
   EXPECT_EQ(choose_split(s.h, s.link(1.0f), 0.1, DecisionScale{Oracle::Standard, 1.0},
-                         RefineLimits{0.2, {}}),
+                         RefineLimits{0.2 * to_frame, {}}),
             Split::Receiver);
 }
 
