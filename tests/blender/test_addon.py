@@ -249,7 +249,7 @@ class DefaultsTest(unittest.TestCase):
 
     def test_solver_options_are_plain_values(self):
         options = self.settings.solver_options()
-        self.assertEqual(options["oracle"], "perceptual")
+        self.assertEqual(options["oracle"], "noticeable")
         self.assertEqual(options["visibility"], "exact")
         for value in options.values():
             self.assertIsInstance(value, (int, float, str))

@@ -215,7 +215,13 @@ class EnergyBalance(unittest.TestCase):
             result = rad.solve(b.scene(rad), oracle="standard", quality=quality, leaf_links="all")
             error[quality] = np.abs(absorbed_power(b, result) / LIGHT_POWER - 1).max()
         self.assertLess(error[0.6], 0.02)
-        self.assertLess(error[0.6], 0.5 * error[0.0])
+        # Refinement takes off at least a third. It took off half while each
+        # wall's closure came from its links alone; from the ray pass (issue
+        # 34), the wall behind the lamp, which sees the lamp's black back, sends
+        # more: -1.55 % at quality 0.6 where -1.16 % before, -2.4 % unrefined
+        # where -2.6 %. Light meeting the back of a one-sided face is lost in
+        # both, so which is nearer the truth is not known yet.
+        self.assertLess(error[0.6], 0.67 * error[0.0])
 
 
 class EmitterSides(unittest.TestCase):
