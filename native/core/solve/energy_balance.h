@@ -50,7 +50,8 @@
 // Where nothing escapes, C_l is 1 less the share its links give to surfaces
 // that do not reflect, and conservation holds by construction: every leaf
 // delivers what it sends. The more escapes, the less that is trusted: C_l
-// moves linearly to the links' own sum by f = kTrustRays. A yes-or-no
+// moves linearly to the links' own sum by f = kTrustRays (a few rays: beside
+// a window the leaves' closure varies too much for the element's one number). A yes-or-no
 // "enclosed" flipped with the last bits of the coordinates for a wall whose
 // top edge sees a lamp's back at a grazing angle (one ray in 2,048), moving
 // that wall's light by 0.7 %.
