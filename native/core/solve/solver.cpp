@@ -355,19 +355,19 @@ void Solver::link_initially() {
   track_memory();
 }
 
-// A side that no light can reach (the inside of a closed box, the floor
-// under it) keeps no links: it would never carry any light, yet its links
-// would be gathered, its elements shown (doubling the box in the output) and
-// its leaks of rounding taken for light. Light starts at the emitting sides
-// and the receivers of light links and spreads through the links, from
-// emitter to receiver; cluster links count as reaching every side of their
-// receiving cluster.
 // A link whose form factor is below this at every sample reaches its receiver
 // through a crack that rounding opens (the inside of a closed box saw the room
 // through its edges at 4e-10 once the scene was scaled to the solver's frame),
 // not through a gap in the geometry.
 constexpr float kCrack = 1e-9f;
 
+// A side that no light can reach (the inside of a closed box, the floor
+// under it) keeps no links: it would never carry any light, yet its links
+// would be gathered, its elements shown (doubling the box in the output) and
+// its leaks of rounding taken for light. Light starts at the emitting sides
+// and the receivers of light links and spreads through the links, from
+// emitter to receiver (through links above kCrack); cluster links count as
+// reaching every side of their receiving cluster.
 void Solver::drop_links_light_cannot_reach() {
   const size_t sides = hierarchy_.root_count();
   std::vector<std::uint8_t> reached(hierarchy_.elements().size(), 0);
