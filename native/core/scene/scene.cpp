@@ -271,6 +271,166 @@ Light in_frame(Light light, const SolverFrame& frame) {
   return light;
 }
 
+// The frame the solver works in (scene.h: centred, one unit across), from
+// the input's extent, after checking the scene is large enough and near
+// enough the origin to be solved precisely.
+struct Extent {
+  SolverFrame frame;
+  double diameter = 0.0;  // in the input's units
+  double reach = 0.0;     // the farthest corner of its bounds from the origin
+};
+
+Extent measure_extent(const SceneArrays& a, size_t vertex_count) {
+  dvec3 lo(1e300), hi(-1e300);
+  for (size_t v = 0; v < vertex_count; ++v) {
+    const dvec3 p(a.positions[3 * v], a.positions[3 * v + 1], a.positions[3 * v + 2]);
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  Extent e;
+  e.diameter = glm::length(hi - lo);
+  if (!(e.diameter >= kMinSceneSize)) {
+    std::ostringstream m;
+    m << "the scene is " << e.diameter << " across; scenes smaller than " << kMinSceneSize
+      << " cannot be solved (scale the scene up)";
+    fail(m.str());
+  }
+  e.reach = std::max(glm::length(lo), glm::length(hi));
+  if (!(e.diameter >= kMinRelativeSize * e.reach)) {
+    std::ostringstream m;
+    m << "the scene is " << e.diameter << " across but " << e.reach
+      << " from the origin: too far for its size to be solved precisely (move it to the origin)";
+    fail(m.str());
+  }
+  e.frame.origin = 0.5 * (lo + hi);
+  e.frame.scale = 1.0 / e.diameter;
+  return e;
+}
+
+// Input face f as patches of `scene` (scene.patches), or a note in
+// scene.skipped of why it was left out; its repairs go to scene.repaired.
+// `polygon` holds its corners in the solver's frame, repeated ones removed.
+void add_face(Scene& scene, const SceneArrays& a, size_t f, std::vector<dvec3>& polygon,
+              size_t repeated, const Extent& extent, double smallest_face,
+              std::vector<std::array<size_t, 3>>& triangles) {
+  const auto face = static_cast<std::uint32_t>(f);
+  PatchBuilder builder{
+      scene,
+      Rgb(a.reflectance[3 * f], a.reflectance[3 * f + 1], a.reflectance[3 * f + 2]),
+      Rgb(a.emission[3 * f], a.emission[3 * f + 1], a.emission[3 * f + 2]),
+      a.two_sided.empty() || a.two_sided[f] != 0,
+      a.occludes.empty() || a.occludes[f] != 0,
+      face};
+  const double diameter = polygon_diameter(polygon);
+  const dvec3 area_normal = polygon_area_normal(polygon);
+  if (polygon.size() < 3 || !(glm::length(area_normal) > kDegenerate * diameter * diameter)) {
+    const FaceIssue why = !(diameter > 0.0) ? FaceIssue::CoincidentCorners
+                          : turns(polygon, diameter)
+                              ? FaceIssue::CrossesItself  // lobes that cancel
+                              : FaceIssue::CollinearCorners;
+    scene.skipped.push_back({.face = face, .issue = why});
+    return;
+  }
+  if (diameter < smallest_face) {
+    // Its size as the user measures it, for the note.
+    scene.skipped.push_back({.face = face,
+                             .issue = FaceIssue::TooSmall,
+                             .size = diameter / extent.frame.scale,
+                             .scene_size = extent.diameter});
+    return;
+  }
+  std::vector<FaceNote> repairs;
+  if (repeated) {
+    repairs.push_back({.face = face,
+                       .issue = FaceIssue::RepeatedCorners,
+                       .count = static_cast<std::uint32_t>(repeated)});
+  }
+  if (polygon.size() == 3 || (polygon.size() == 4 && is_convex_planar_quad(polygon))) {
+    builder.add(polygon);
+  } else {
+    const dvec3 normal = glm::normalize(area_normal);
+    const std::vector<dvec2> flat = project(polygon, normal);
+    if (self_intersecting(flat) || !triangulate(flat, triangles)) {
+      // A bow-tie has no inside: Blender draws it as triangles that overlap,
+      // facing opposite ways, and each would send its light twice.
+      scene.skipped.push_back({.face = face, .issue = FaceIssue::CrossesItself});
+      return;
+    }
+    for (const auto& t : triangles) {
+      const dvec3 tri[3] = {polygon[t[0]], polygon[t[1]], polygon[t[2]]};
+      builder.add(tri);
+    }
+    const double bent = bend(polygon, normal, diameter);
+    if (bent > kPlanar) {
+      repairs.push_back({.face = face,
+                         .issue = FaceIssue::NotPlanar,
+                         .count = static_cast<std::uint32_t>(builder.made),
+                         .bend = bent});
+    }
+  }
+  if (builder.made == 0) {
+    scene.skipped.push_back({.face = face, .issue = FaceIssue::NoTriangles});
+    return;
+  }
+  scene.repaired.insert(scene.repaired.end(), repairs.begin(), repairs.end());
+}
+
+// Every input face as patches (add_face), in the solver's frame.
+void add_faces(Scene& scene, const SceneArrays& a, const Extent& extent) {
+  const auto vertex = [&](std::int64_t i) {
+    const size_t k = static_cast<size_t>(i) * 3;
+    return extent.frame.to_solver(dvec3(a.positions[k], a.positions[k + 1], a.positions[k + 2]));
+  };
+  // Faces too small to solve in floating point (scene.h): the input's
+  // coordinates carry their rounding at `reach` from the origin.
+  const double smallest_face = std::max(kMinRelativeFaceSize * scene.diameter,
+                                        kMinFaceSizeOfReach * extent.reach * extent.frame.scale);
+  size_t offset = 0;
+  std::vector<dvec3> polygon;
+  std::vector<std::array<size_t, 3>> triangles;
+  for (size_t f = 0; f < scene.face_count; ++f) {
+    const size_t size = static_cast<size_t>(a.face_sizes[f]);
+    polygon.clear();
+    for (size_t k = 0; k < size; ++k) {
+      const dvec3 v = vertex(a.face_vertices[offset + k]);
+      if (polygon.empty() || v != polygon.back()) polygon.push_back(v);
+    }
+    offset += size;
+    while (polygon.size() > 1 && polygon.front() == polygon.back()) polygon.pop_back();
+    add_face(scene, a, f, polygon, size - polygon.size(), extent, smallest_face, triangles);
+  }
+}
+
+// The area of the patches' sides and the power they emit (scene.h's totals).
+void sum_area_and_power(Scene& scene) {
+  for (const Patch& p : scene.patches) {
+    if (!p.sides[0].present && !p.sides[1].present) continue;
+    scene.total_area += p.area;
+    for (const PatchSide& side : p.sides)
+      if (side.present) scene.emitted_power += luminance(side.emission) * p.area;
+  }
+}
+
+// The lights that shine, in the solver's frame, and the world's light as a sky.
+void add_lights(Scene& scene, const SceneArrays& a) {
+  for (size_t i = 0; i < a.lights.size(); ++i) check_light(a.lights[i], i);
+  for (const Light& light : a.lights)
+    if (luminance(light.colour) > 0.0) scene.lights.push_back(in_frame(light, scene.frame));
+  for (int c = 0; c < 3; ++c) {
+    if (!(a.world[c] >= 0.0 && a.world[c] <= kMaxInputRadiance)) {
+      std::ostringstream m;
+      m << "the world's radiance must lie in [0, " << kMaxInputRadiance << "]";
+      fail(m.str());
+    }
+  }
+  if (luminance(a.world) > 0.0) {
+    Light sky;
+    sky.kind = LightKind::Sky;
+    sky.colour = a.world;
+    scene.lights.push_back(sky);
+  }
+}
+
 }  // namespace
 
 std::string_view face_issue_name(FaceIssue issue) {
@@ -306,141 +466,18 @@ Scene make_scene(const SceneArrays& a) {
   Scene scene;
   scene.face_count = a.face_sizes.size();
   scene.vertex_count = a.positions.size() / 3;
-  const auto world_vertex = [&](std::int64_t i) {
-    const size_t k = static_cast<size_t>(i) * 3;
-    return dvec3(a.positions[k], a.positions[k + 1], a.positions[k + 2]);
-  };
-  dvec3 lo(1e300), hi(-1e300);
-  for (size_t v = 0; v < scene.vertex_count; ++v) {
-    lo = glm::min(lo, world_vertex(static_cast<std::int64_t>(v)));
-    hi = glm::max(hi, world_vertex(static_cast<std::int64_t>(v)));
-  }
-  const double world_diameter = glm::length(hi - lo);
-  if (!(world_diameter >= kMinSceneSize)) {
-    std::ostringstream m;
-    m << "the scene is " << world_diameter << " across; scenes smaller than " << kMinSceneSize
-      << " cannot be solved (scale the scene up)";
-    fail(m.str());
-  }
-  const double reach = std::max(glm::length(lo), glm::length(hi));
-  if (!(world_diameter >= kMinRelativeSize * reach)) {
-    std::ostringstream m;
-    m << "the scene is " << world_diameter << " across but " << reach
-      << " from the origin: too far for its size to be solved precisely (move it to the origin)";
-    fail(m.str());
-  }
-  scene.frame.origin = 0.5 * (lo + hi);
-  scene.frame.scale = 1.0 / world_diameter;
-  scene.diameter = world_diameter * scene.frame.scale;
-  const auto vertex = [&](std::int64_t i) { return scene.frame.to_solver(world_vertex(i)); };
-  // A length in the solver's frame as the user measures it, for messages and notes.
-  const auto in_world = [&](double length) { return length / scene.frame.scale; };
-
-  // Faces too small to solve in floating point (scene.h): the input's
-  // coordinates carry their rounding at `reach` from the origin.
-  const double smallest_face = std::max(kMinRelativeFaceSize * scene.diameter,
-                                        kMinFaceSizeOfReach * reach * scene.frame.scale);
-  size_t offset = 0;
-  std::vector<dvec3> polygon;
-  std::vector<std::array<size_t, 3>> triangles;
-  for (size_t f = 0; f < scene.face_count; ++f) {
-    const auto face = static_cast<std::uint32_t>(f);
-    const size_t size = static_cast<size_t>(a.face_sizes[f]);
-    polygon.clear();
-    for (size_t k = 0; k < size; ++k) {
-      const dvec3 v = vertex(a.face_vertices[offset + k]);
-      if (polygon.empty() || v != polygon.back()) polygon.push_back(v);
-    }
-    offset += size;
-    while (polygon.size() > 1 && polygon.front() == polygon.back()) polygon.pop_back();
-    const size_t repeated = size - polygon.size();
-    PatchBuilder builder{
-        scene,
-        Rgb(a.reflectance[3 * f], a.reflectance[3 * f + 1], a.reflectance[3 * f + 2]),
-        Rgb(a.emission[3 * f], a.emission[3 * f + 1], a.emission[3 * f + 2]),
-        a.two_sided.empty() || a.two_sided[f] != 0,
-        a.occludes.empty() || a.occludes[f] != 0,
-        face};
-    const double diameter = polygon_diameter(polygon);
-    const dvec3 area_normal = polygon_area_normal(polygon);
-    if (polygon.size() < 3 || !(glm::length(area_normal) > kDegenerate * diameter * diameter)) {
-      const FaceIssue why = !(diameter > 0.0) ? FaceIssue::CoincidentCorners
-                            : turns(polygon, diameter)
-                                ? FaceIssue::CrossesItself  // lobes that cancel
-                                : FaceIssue::CollinearCorners;
-      scene.skipped.push_back({.face = face, .issue = why});
-      continue;
-    }
-    if (diameter < smallest_face) {
-      scene.skipped.push_back({.face = face,
-                               .issue = FaceIssue::TooSmall,
-                               .size = in_world(diameter),
-                               .scene_size = world_diameter});
-      continue;
-    }
-    std::vector<FaceNote> repairs;
-    if (repeated) {
-      repairs.push_back({.face = face,
-                         .issue = FaceIssue::RepeatedCorners,
-                         .count = static_cast<std::uint32_t>(repeated)});
-    }
-    if (polygon.size() == 3 || (polygon.size() == 4 && is_convex_planar_quad(polygon))) {
-      builder.add(polygon);
-    } else {
-      const dvec3 normal = glm::normalize(area_normal);
-      const std::vector<dvec2> flat = project(polygon, normal);
-      if (self_intersecting(flat) || !triangulate(flat, triangles)) {
-        // A bow-tie has no inside: Blender draws it as triangles that overlap,
-        // facing opposite ways, and each would send its light twice.
-        scene.skipped.push_back({.face = face, .issue = FaceIssue::CrossesItself});
-        continue;
-      }
-      for (const auto& t : triangles) {
-        const dvec3 tri[3] = {polygon[t[0]], polygon[t[1]], polygon[t[2]]};
-        builder.add(tri);
-      }
-      const double bent = bend(polygon, normal, diameter);
-      if (bent > kPlanar) {
-        repairs.push_back({.face = face,
-                           .issue = FaceIssue::NotPlanar,
-                           .count = static_cast<std::uint32_t>(builder.made),
-                           .bend = bent});
-      }
-    }
-    if (builder.made == 0) {
-      scene.skipped.push_back({.face = face, .issue = FaceIssue::NoTriangles});
-      continue;
-    }
-    scene.repaired.insert(scene.repaired.end(), repairs.begin(), repairs.end());
-  }
+  const Extent extent = measure_extent(a, scene.vertex_count);
+  scene.frame = extent.frame;
+  scene.diameter = extent.diameter * scene.frame.scale;
+  add_faces(scene, a, extent);
   if (scene.patches.empty()) {
     fail("every face is degenerate or broken and was skipped (face " +
          std::to_string(scene.skipped.front().face) + ": " +
          std::string(face_issue_name(scene.skipped.front().issue)) + "); nothing to solve");
   }
   mesh_contacts(scene);
-  for (const Patch& p : scene.patches) {
-    if (!p.sides[0].present && !p.sides[1].present) continue;
-    scene.total_area += p.area;
-    for (const PatchSide& side : p.sides)
-      if (side.present) scene.emitted_power += luminance(side.emission) * p.area;
-  }
-  for (size_t i = 0; i < a.lights.size(); ++i) check_light(a.lights[i], i);
-  for (const Light& light : a.lights)
-    if (luminance(light.colour) > 0.0) scene.lights.push_back(in_frame(light, scene.frame));
-  for (int c = 0; c < 3; ++c) {
-    if (!(a.world[c] >= 0.0 && a.world[c] <= kMaxInputRadiance)) {
-      std::ostringstream m;
-      m << "the world's radiance must lie in [0, " << kMaxInputRadiance << "]";
-      fail(m.str());
-    }
-  }
-  if (luminance(a.world) > 0.0) {
-    Light sky;
-    sky.kind = LightKind::Sky;
-    sky.colour = a.world;
-    scene.lights.push_back(sky);
-  }
+  sum_area_and_power(scene);
+  add_lights(scene, a);
   if (!(scene.emitted_power > 0.0) && scene.lights.empty()) {
     fail("the scene has no emitter: no face emits, and there is no light and no world colour");
   }
