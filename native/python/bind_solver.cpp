@@ -340,14 +340,13 @@ int read_count(const py::object& value, const char* name, std::int64_t lo, std::
   return static_cast<int>(index.cast<std::int64_t>());
 }
 
-PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
-                  const py::object& max_elements, std::optional<double> time_budget,
-                  const std::string& visibility, const py::object& rays, const py::object& bounces,
-                  const py::object& threads, const py::object& progress, const py::object& cancel,
-                  double min_element_area, const std::string& leaf_links,
-                  std::optional<double> cluster_separation, const py::object& memory_limit,
-                  bool pass_results, bool yield_to_interface, const py::object& reuse,
-                  const py::object& clock) {
+// The options of solve() but for its callbacks, checked.
+SolveOptions read_options(const std::string& oracle, double quality, const py::object& max_elements,
+                          std::optional<double> time_budget, const std::string& visibility,
+                          const py::object& rays, const py::object& bounces,
+                          const py::object& threads, double min_element_area,
+                          const std::string& leaf_links, std::optional<double> cluster_separation,
+                          const py::object& memory_limit, bool yield_to_interface) {
   SolveOptions options;
   options.oracle = read_oracle(oracle);
   options.quality = quality;
@@ -380,7 +379,101 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
     throw std::invalid_argument("leaf_links must be 'none', 'near' or 'all', got '" + leaf_links +
                                 "'");
   options.leaf_links = *links;
+  return options;
+}
 
+// The first exception of a Python callback or clock the solve's threads
+// called: it stops the solve and is raised afterwards.
+struct CallbackError {
+  std::exception_ptr error;
+  std::atomic<bool> failed{false};
+  void keep(std::exception_ptr e) {  // with the GIL held
+    error = std::move(e);
+    failed = true;
+  }
+};
+
+// solve(progress=...) as the solver calls it: a ProgressMonitor's record, or
+// the Python callable called with the GIL (both alive while the solve runs).
+ProgressCallback progress_callback(const py::object& progress, bool pass_results,
+                                   CallbackError& failure) {
+  if (py::isinstance<ProgressMonitor>(progress)) {
+    ProgressMonitor* monitor = progress.cast<ProgressMonitor*>();
+    monitor->keep_pass_results = monitor->keep_pass_results || pass_results;
+    return [monitor](const SolveProgress& p) { monitor->record(p); };
+  }
+  if (progress.is_none()) return {};
+  if (!PyCallable_Check(progress.ptr()))
+    throw std::invalid_argument("progress must be callable, a ProgressMonitor or None");
+  return [&progress, pass_results, &failure](const SolveProgress& p) {
+    py::gil_scoped_acquire gil;
+    if (failure.error) return;
+    try {
+      py::dict d = progress_dict(p);
+      // A copy: the solver goes on refining the hierarchy this mesh came from.
+      if (pass_results && p.pass_result) d["result"] = to_python(SolveResult(*p.pass_result));
+      progress(d);
+    } catch (...) {
+      failure.keep(std::current_exception());
+    }
+  };
+}
+
+// solve(clock=...) as the solver reads it, from the solve's threads; a
+// failing clock stops the solve like a failing callback (its time then reads
+// as past any budget).
+std::function<double()> python_clock(const py::object& clock, CallbackError& failure) {
+  if (clock.is_none()) return {};
+  if (!PyCallable_Check(clock.ptr())) throw std::invalid_argument("clock must be callable or None");
+  return [&clock, &failure]() -> double {
+    py::gil_scoped_acquire gil;
+    if (!failure.error) {
+      try {
+        return py::cast<double>(clock());
+      } catch (...) {
+        failure.keep(std::current_exception());
+      }
+    }
+    return std::numeric_limits<double>::infinity();
+  };
+}
+
+// solve() without the GIL, with `kept` locked for it if given.
+SolveResult solve_released(const Scene& scene, const SolveOptions& options,
+                           const ProgressCallback& callback, const CancelCheck& cancelled,
+                           PyReuse* kept) {
+  // Taken before the GIL goes: a second solve with the same reuse fails at once.
+  std::unique_lock<std::mutex> in_use;
+  if (kept) {
+    in_use = std::unique_lock<std::mutex>(kept->mutex, std::try_to_lock);
+    if (!in_use.owns_lock())
+      throw std::invalid_argument("this SolveReuse is in use by another solve");
+  }
+  SolveResult result;
+  {
+    py::gil_scoped_release release;
+    try {
+      result = solve(scene, options, callback, cancelled, kept ? &kept->reuse : nullptr);
+    } catch (...) {
+      if (kept) kept->note();
+      throw;
+    }
+  }
+  if (kept) kept->note();
+  return result;
+}
+
+PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
+                  const py::object& max_elements, std::optional<double> time_budget,
+                  const std::string& visibility, const py::object& rays, const py::object& bounces,
+                  const py::object& threads, const py::object& progress, const py::object& cancel,
+                  double min_element_area, const std::string& leaf_links,
+                  std::optional<double> cluster_separation, const py::object& memory_limit,
+                  bool pass_results, bool yield_to_interface, const py::object& reuse,
+                  const py::object& clock) {
+  SolveOptions options = read_options(oracle, quality, max_elements, time_budget, visibility, rays,
+                                      bounces, threads, min_element_area, leaf_links,
+                                      cluster_separation, memory_limit, yield_to_interface);
   PyReuse* kept = nullptr;
   if (!reuse.is_none()) {
     if (!py::isinstance<PyReuse>(reuse))
@@ -393,73 +486,14 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
       throw std::invalid_argument("cancel must be a CancelToken or None");
     token = cancel.cast<CancelToken*>();
   }
-  // A failing callback stops the solve; its exception is raised afterwards.
-  std::exception_ptr callback_error;
-  std::atomic<bool> callback_failed{false};
-  ProgressCallback callback;
-  if (py::isinstance<ProgressMonitor>(progress)) {
-    ProgressMonitor* monitor = progress.cast<ProgressMonitor*>();
-    monitor->keep_pass_results = monitor->keep_pass_results || pass_results;
-    callback = [monitor](const SolveProgress& p) { monitor->record(p); };
-  } else if (!progress.is_none()) {
-    if (!PyCallable_Check(progress.ptr()))
-      throw std::invalid_argument("progress must be callable, a ProgressMonitor or None");
-    callback = [&](const SolveProgress& p) {
-      py::gil_scoped_acquire gil;
-      if (callback_error) return;
-      try {
-        py::dict d = progress_dict(p);
-        // A copy: the solver goes on refining the hierarchy this mesh came from.
-        if (pass_results && p.pass_result) d["result"] = to_python(SolveResult(*p.pass_result));
-        progress(d);
-      } catch (...) {
-        callback_error = std::current_exception();
-        callback_failed = true;
-      }
-    };
-  }
-  if (!clock.is_none()) {
-    if (!PyCallable_Check(clock.ptr()))
-      throw std::invalid_argument("clock must be callable or None");
-    // Read from the solve's threads; a failing clock stops the solve like a
-    // failing callback (its time then reads as past any budget).
-    options.clock = [&]() -> double {
-      py::gil_scoped_acquire gil;
-      if (!callback_error) {
-        try {
-          return py::cast<double>(clock());
-        } catch (...) {
-          callback_error = std::current_exception();
-          callback_failed = true;
-        }
-      }
-      return std::numeric_limits<double>::infinity();
-    };
-  }
+  CallbackError failure;
+  const ProgressCallback callback = progress_callback(progress, pass_results, failure);
+  options.clock = python_clock(clock, failure);
   const CancelCheck cancelled = [&] {
-    return callback_failed.load() || (token && token->flag.load());
+    return failure.failed.load() || (token && token->flag.load());
   };
-  SolveResult result;
-  {
-    // Taken before the GIL goes: a second solve with the same reuse fails at once.
-    std::unique_lock<std::mutex> in_use;
-    if (kept) {
-      in_use = std::unique_lock<std::mutex>(kept->mutex, std::try_to_lock);
-      if (!in_use.owns_lock())
-        throw std::invalid_argument("this SolveReuse is in use by another solve");
-    }
-    {
-      py::gil_scoped_release release;
-      try {
-        result = solve(scene, options, callback, cancelled, kept ? &kept->reuse : nullptr);
-      } catch (...) {
-        if (kept) kept->note();
-        throw;
-      }
-    }
-    if (kept) kept->note();
-  }
-  if (callback_error) std::rethrow_exception(callback_error);
+  SolveResult result = solve_released(scene, options, callback, cancelled, kept);
+  if (failure.error) std::rethrow_exception(failure.error);
   return to_python(std::move(result));
 }
 

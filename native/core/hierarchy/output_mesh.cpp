@@ -160,93 +160,138 @@ void ForeignVertices::append_between(std::int32_t root, std::uint32_t a, std::ui
   }
 }
 
+// Whether each side of each patch is output (index 2 patch + side): a side is
+// shown when light reaches it or it emits (the back of a two-sided lamp seen
+// from above); a face that no light reaches shows its front, dark, so the
+// geometry stays whole.
+std::vector<std::uint8_t> shown_sides(const Hierarchy& h) {
+  const Scene& scene = h.scene();
+  std::vector<std::uint8_t> lit(2 * scene.patches.size(), 0);
+  for (const Element& e : h.elements()) lit[2 * e.patch + e.side] |= e.has_links;
+  std::vector<std::uint8_t> shown(lit.size(), 0);
+  for (std::uint32_t patch = 0; patch < scene.patches.size(); ++patch) {
+    for (int side = 0; side < 2; ++side) {
+      const size_t k = 2 * patch + static_cast<size_t>(side);
+      if (h.root(patch, side) == kNone) continue;
+      shown[k] = lit[k] ||
+                 luminance(scene.patches[patch].sides[static_cast<size_t>(side)].emission) > 0.0 ||
+                 (side == 0 && !lit[2 * patch + 1]);
+    }
+  }
+  return shown;
+}
+
+// Radiance and gathered H (before rho and L_e) at the pool's vertices: the
+// mean over the shown leaves that have it as a corner.
+class VertexValues {
+ public:
+  VertexValues(const Hierarchy& h, const std::vector<std::array<Rgb, kMaxSamples>>& leaf_irradiance,
+               const std::vector<std::uint8_t>& shown)
+      : sums_(h.vertex_count()) {
+    const auto& elements = h.elements();
+    for (size_t i = 0; i < elements.size(); ++i) {
+      const Element& e = elements[i];
+      if (!e.is_leaf() || !shown[2 * e.patch + e.side]) continue;
+      const Rgb rho = h.reflectance(e), emission = h.emission(e);
+      for (int k = 0; k < e.corner_count; ++k) {
+        // Energy-conserving link corrections (link_transport.cpp) may leave a
+        // sample a rounding below zero; light is never negative.
+        const Rgb gathered = glm::max(leaf_irradiance[i][static_cast<size_t>(k)], Rgb(0.0));
+        Sum& sum = sums_[e.corner[static_cast<size_t>(k)]];
+        sum.radiance += glm::dvec3(emission + rho * gathered);
+        sum.gathered += glm::dvec3(gathered);
+        ++sum.count;
+      }
+    }
+  }
+  glm::dvec3 radiance(std::uint32_t v) const {
+    return sums_[v].count ? sums_[v].radiance / static_cast<double>(sums_[v].count)
+                          : glm::dvec3(0.0);
+  }
+  glm::dvec3 gathered(std::uint32_t v) const {
+    return sums_[v].count ? sums_[v].gathered / static_cast<double>(sums_[v].count)
+                          : glm::dvec3(0.0);
+  }
+
+ private:
+  struct Sum {
+    glm::dvec3 radiance{0.0}, gathered{0.0};
+    std::uint32_t count = 0;
+  };
+  std::vector<Sum> sums_;
+};
+
+// The output mesh's vertices as they are made: each pool vertex once, and a
+// foreign vertex on a polygon's edge with that polygon's values.
+class OutputVertices {
+ public:
+  OutputVertices(const Hierarchy& h, const VertexValues& values, OutputMesh& mesh)
+      : h_(h), values_(values), mesh_(mesh), remap_(h.vertex_count(), kNone) {}
+
+  // The output index of pool vertex v.
+  std::int32_t pool(std::uint32_t v) {
+    if (remap_[v] == kNone) remap_[v] = add(h_.vertex(v), values_.radiance(v), values_.gathered(v));
+    return remap_[v];
+  }
+
+  // A foreign vertex is placed where the other patch has it, with this
+  // polygon's own radiance there (interpolated along its edge from a to b):
+  // the other patch may lie across a discontinuity (contact.h), whose light
+  // must not bleed over.
+  std::int32_t interpolated(std::uint32_t v, std::uint32_t a, std::uint32_t b) {
+    const dvec3 p = h_.vertex(v), pa = h_.vertex(a), ab = h_.vertex(b) - pa;
+    const double t = std::clamp(glm::dot(p - pa, ab) / glm::dot(ab, ab), 0.0, 1.0);
+    return add(p, (1 - t) * values_.radiance(a) + t * values_.radiance(b),
+               (1 - t) * values_.gathered(a) + t * values_.gathered(b));
+  }
+
+ private:
+  std::int32_t add(const dvec3& solver_position, const glm::dvec3& radiance,
+                   const glm::dvec3& gathered) {
+    const auto index = static_cast<std::int32_t>(mesh_.positions.size() / 3);
+    const dvec3 world = h_.scene().frame.to_world(solver_position);
+    mesh_.positions.insert(mesh_.positions.end(), {world.x, world.y, world.z});
+    append(mesh_.radiance, radiance);
+    append(mesh_.vertex_irradiance, gathered);
+    return index;
+  }
+  static void append(std::vector<float>& out, const glm::dvec3& value) {
+    out.insert(out.end(), {static_cast<float>(value.x), static_cast<float>(value.y),
+                           static_cast<float>(value.z)});
+  }
+
+  const Hierarchy& h_;
+  const VertexValues& values_;
+  OutputMesh& mesh_;
+  std::vector<std::int32_t> remap_;
+};
+
+// The top-level element each element descends from.
+std::vector<std::int32_t> roots_of(const std::vector<Element>& elements) {
+  std::vector<std::int32_t> root_of(elements.size());
+  for (size_t i = 0; i < elements.size(); ++i)  // parents come before children
+    root_of[i] = elements[i].parent == kNone ? static_cast<std::int32_t>(i)
+                                             : root_of[static_cast<size_t>(elements[i].parent)];
+  return root_of;
+}
+
 }  // namespace
 
 OutputMesh make_output_mesh(const Hierarchy& h,
                             const std::vector<std::array<Rgb, kMaxSamples>>& leaf_irradiance) {
   const auto& elements = h.elements();
-  const Scene& scene = h.scene();
-
-  // A side is shown when light reaches it or it emits (the back of a two-sided
-  // lamp seen from above); a face that no light reaches shows its front, dark,
-  // so the geometry stays whole.
-  std::vector<std::uint8_t> lit(2 * scene.patches.size(), 0);
-  for (const Element& e : elements) lit[2 * e.patch + e.side] |= e.has_links;
-  const auto shown = [&](std::uint32_t patch, int side) {
-    if (h.root(patch, side) == kNone) return false;
-    if (lit[2 * patch + static_cast<size_t>(side)]) return true;
-    if (luminance(scene.patches[patch].sides[static_cast<size_t>(side)].emission) > 0.0)
-      return true;
-    return side == 0 && !lit[2 * patch + 1];
-  };
-
-  // Radiance at pool vertices: the mean over the leaves that have it as a corner.
-  // Per vertex: radiance and gathered H (before rho and L_e) summed, and how many leaves.
-  struct VertexSum {
-    glm::dvec3 radiance{0.0}, gathered{0.0};
-    std::uint32_t count = 0;
-  };
-  std::vector<VertexSum> sums(h.vertex_count());
-  for (size_t i = 0; i < elements.size(); ++i) {
-    const Element& e = elements[i];
-    if (!e.is_leaf() || !shown(e.patch, e.side)) continue;
-    const Rgb rho = h.reflectance(e), emission = h.emission(e);
-    for (int k = 0; k < e.corner_count; ++k) {
-      // Energy-conserving link corrections (link_transport.cpp) may leave a
-      // sample a rounding below zero; light is never negative.
-      const Rgb gathered = glm::max(leaf_irradiance[i][static_cast<size_t>(k)], Rgb(0.0));
-      VertexSum& sum = sums[e.corner[static_cast<size_t>(k)]];
-      sum.radiance += glm::dvec3(emission + rho * gathered);
-      sum.gathered += glm::dvec3(gathered);
-      ++sum.count;
-    }
-  }
-
+  const std::vector<std::uint8_t> shown = shown_sides(h);
+  const VertexValues values(h, leaf_irradiance, shown);
   OutputMesh mesh;
-  const auto append = [](std::vector<float>& out, const glm::dvec3& value) {
-    out.insert(out.end(), {static_cast<float>(value.x), static_cast<float>(value.y),
-                           static_cast<float>(value.z)});
-  };
-  const auto radiance_at = [&](std::uint32_t v) {
-    return sums[v].count ? sums[v].radiance / static_cast<double>(sums[v].count) : glm::dvec3(0.0);
-  };
-  const auto gathered_at = [&](std::uint32_t v) {
-    return sums[v].count ? sums[v].gathered / static_cast<double>(sums[v].count) : glm::dvec3(0.0);
-  };
-  std::vector<std::int32_t> remap(h.vertex_count(), kNone);
-  const auto output_vertex = [&](std::uint32_t v) {
-    if (remap[v] == kNone) {
-      remap[v] = static_cast<std::int32_t>(mesh.positions.size() / 3);
-      const dvec3 p = h.scene().frame.to_world(h.vertex(v));
-      mesh.positions.insert(mesh.positions.end(), {p.x, p.y, p.z});
-      append(mesh.radiance, radiance_at(v));
-      append(mesh.vertex_irradiance, gathered_at(v));
-    }
-    return remap[v];
-  };
+  OutputVertices vertices(h, values, mesh);
   const ForeignVertices foreign(h);
-  std::vector<std::int32_t> root_of(elements.size());
-  for (size_t i = 0; i < elements.size(); ++i)  // parents come before children
-    root_of[i] = elements[i].parent == kNone ? static_cast<std::int32_t>(i)
-                                             : root_of[static_cast<size_t>(elements[i].parent)];
-  // A foreign vertex is placed where the other patch has it, with this
-  // polygon's own radiance there (interpolated along its edge): the other
-  // patch may lie across a discontinuity (contact.h), whose light must not
-  // bleed over.
-  const auto interpolated_vertex = [&](std::uint32_t v, std::uint32_t a, std::uint32_t b) {
-    const dvec3 p = h.vertex(v), pa = h.vertex(a), ab = h.vertex(b) - pa;
-    const double t = std::clamp(glm::dot(p - pa, ab) / glm::dot(ab, ab), 0.0, 1.0);
-    const auto index = static_cast<std::int32_t>(mesh.positions.size() / 3);
-    const dvec3 world = h.scene().frame.to_world(p);
-    mesh.positions.insert(mesh.positions.end(), {world.x, world.y, world.z});
-    append(mesh.radiance, (1 - t) * radiance_at(a) + t * radiance_at(b));
-    append(mesh.vertex_irradiance, (1 - t) * gathered_at(a) + t * gathered_at(b));
-    return index;
-  };
+  const std::vector<std::int32_t> root_of = roots_of(elements);
+  // One polygon per shown leaf: its corners, the vertices finer neighbours
+  // made on its edges, and the foreign vertices there.
   std::vector<std::uint32_t> edge, between;
   for (size_t i = 0; i < elements.size(); ++i) {
     const Element& e = elements[i];
-    if (!e.is_leaf() || !shown(e.patch, e.side)) continue;
+    if (!e.is_leaf() || !shown[2 * e.patch + e.side]) continue;
     const size_t polygon_start = mesh.face_vertices.size();
     for (int k = 0; k < e.corner_count; ++k) {
       const std::uint32_t a = e.corner[static_cast<size_t>(k)];
@@ -255,11 +300,11 @@ OutputMesh make_output_mesh(const Hierarchy& h,
       boundary_chain(h, a, b, edge);
       edge.push_back(b);
       for (size_t j = 0; j + 1 < edge.size(); ++j) {
-        mesh.face_vertices.push_back(output_vertex(edge[j]));
+        mesh.face_vertices.push_back(vertices.pool(edge[j]));
         between.clear();
         foreign.append_between(root_of[i], edge[j], edge[j + 1], between);
         for (std::uint32_t v : between)
-          mesh.face_vertices.push_back(interpolated_vertex(v, edge[j], edge[j + 1]));
+          mesh.face_vertices.push_back(vertices.interpolated(v, edge[j], edge[j + 1]));
       }
     }
     mesh.face_sizes.push_back(static_cast<std::int32_t>(mesh.face_vertices.size() - polygon_start));

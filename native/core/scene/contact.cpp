@@ -470,101 +470,110 @@ void append_patches(const Patch& source, const Piece& piece, std::vector<Patch>&
   if (i + 1 < n) emit({0, i, i + 1});
 }
 
-}  // namespace
-
-void mesh_contacts(Scene& scene) {
-  std::vector<Patch>& patches = scene.patches;
-  const size_t n = patches.size();
-  if (n < 2) {
-    scene.occluders = patches;
-    return;
-  }
-  std::vector<Triangle> triangles;
+// The patches as triangles in a BVH, each triangle's patch in `owner`.
+struct PatchBvh {
+  SceneBvh bvh;
   std::vector<std::uint32_t> owner;
-  for (std::uint32_t p = 0; p < n; ++p) {
+};
+
+PatchBvh patch_bvh(const std::vector<Patch>& patches) {
+  std::vector<Triangle> triangles;
+  PatchBvh out;
+  for (std::uint32_t p = 0; p < patches.size(); ++p) {
     const Patch& patch = patches[p];
     triangles.push_back({{patch.corners[0], patch.corners[1], patch.corners[2]}});
-    owner.push_back(p);
+    out.owner.push_back(p);
     if (patch.corner_count == 4) {
       triangles.push_back({{patch.corners[0], patch.corners[2], patch.corners[3]}});
-      owner.push_back(p);
+      out.owner.push_back(p);
     }
   }
-  const SceneBvh bvh = build_scene_bvh(triangles);
-  std::vector<double> diameter(n);
-  for (size_t p = 0; p < n; ++p) diameter[p] = diameter_of(patches[p]);
+  out.bvh = build_scene_bvh(triangles);
+  return out;
+}
 
-  // Each patch cut on its own, in parallel: deterministic.
-  std::vector<std::vector<Piece>> cut(n);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const auto& range) {
-    std::vector<std::uint32_t> near;
-    for (size_t p = range.begin(); p != range.end(); ++p) {
-      const Patch& patch = patches[p];
-      const Frame f = frame_of(patch);
-      Aabb box;
-      for (int k = 0; k < patch.corner_count; ++k) box.grow(patch.corners[static_cast<size_t>(k)]);
-      const dvec3 margin(kCoverGap * diameter[p] + kCoincidentScene * scene.diameter);
-      box.lo -= margin;
-      box.hi += margin;
-      near.clear();
-      // A face that casts no shadow (a Blender light) neither cuts nor is cut.
-      if (patch.occludes)
-        traverse_scene_bvh(
-            bvh,
-            [&](const Aabb& b) {
-              return b.lo.x <= box.hi.x && b.hi.x >= box.lo.x && b.lo.y <= box.hi.y &&
-                     b.hi.y >= box.lo.y && b.lo.z <= box.hi.z && b.hi.z >= box.lo.z;
-            },
-            [&](std::uint32_t t) {
-              const std::uint32_t q = owner[t];
-              if (q != p && patches[q].surface != patch.surface && patches[q].occludes)
-                near.push_back(q);
-            });
-      std::sort(near.begin(), near.end());
-      near.erase(std::unique(near.begin(), near.end()), near.end());
+// The patches of other surfaces near patch p that may cut it, sorted (into
+// `near`). A face that casts no shadow (a Blender light) neither cuts nor is cut.
+void near_patches(const std::vector<Patch>& patches, const PatchBvh& found, size_t p,
+                  double margin_size, std::vector<std::uint32_t>& near) {
+  const Patch& patch = patches[p];
+  near.clear();
+  if (!patch.occludes) return;
+  Aabb box;
+  for (int k = 0; k < patch.corner_count; ++k) box.grow(patch.corners[static_cast<size_t>(k)]);
+  const dvec3 margin(margin_size);
+  box.lo -= margin;
+  box.hi += margin;
+  traverse_scene_bvh(
+      found.bvh,
+      [&](const Aabb& b) {
+        return b.lo.x <= box.hi.x && b.hi.x >= box.lo.x && b.lo.y <= box.hi.y &&
+               b.hi.y >= box.lo.y && b.lo.z <= box.hi.z && b.hi.z >= box.lo.z;
+      },
+      [&](std::uint32_t t) {
+        const std::uint32_t q = found.owner[t];
+        if (q != p && patches[q].surface != patch.surface && patches[q].occludes) near.push_back(q);
+      });
+  std::sort(near.begin(), near.end());
+  near.erase(std::unique(near.begin(), near.end()), near.end());
+}
 
-      const double thinnest = kThinnest * diameter[p];
-      std::vector<Cut> cuts;
-      std::vector<std::pair<std::uint32_t, std::vector<dvec2>>> coincident;
-      Features features;
-      const double touch_p = kCoincidentScene * scene.diameter;
-      for (std::uint32_t q : near) {
-        Contact c = contact_of(f, diameter[p], patches[q], diameter[q], scene.diameter);
-        // Around a light every piece counts (what lies behind it is bright);
-        // elsewhere a strip narrower than kNarrowest is left uncut.
-        const double narrowest = emits(patches[q]) ? thinnest : kNarrowest * diameter[p];
-        for (const Segment& segment : c.cuts)
-          if (glm::length(segment.b - segment.a) > thinnest) cuts.push_back({segment, narrowest});
-        if (c.meets) features.meetings.push_back({c.cuts[0], c.crosses});
-        if (!c.cover_outline.empty()) {
-          features.covers.push_back(
-              {c.cover_outline,
-               c.gap > std::max(touch_p, kCoincident * diameter[p]) ? c.gap : 0.0});
-          if (c.coincident) coincident.emplace_back(q, std::move(c.cover_outline));
-        }
-      }
-      Polygon2 whole;
-      for (int k = 0; k < patch.corner_count; ++k)
-        whole.push_back(
-            {f.to2(patch.corners[static_cast<size_t>(k)]), patch.corners[static_cast<size_t>(k)]});
-      std::vector<Polygon2> pieces = cut_along(whole, std::move(cuts), thinnest);
-      for (Polygon2& polygon : pieces) {
-        Piece piece;
-        const std::vector<dvec2> points = points_of(polygon);
-        piece.area = std::abs(signed_area(points));
-        const dvec2 c = centroid_of(points);
-        piece.centre = f.origin + c.x * f.u + c.y * f.v;
-        for (const auto& [q, outline] : coincident)
-          if (inside(outline, c, thinnest)) piece.coincides_with.push_back(q);
-        mark_discontinuities(piece, polygon, whole, features, c, thinnest);
-        piece.polygon = std::move(polygon);
-        piece.sides = patch.sides;
-        cut[p].push_back(std::move(piece));
-      }
+// Patch p cut along where the patches `near` it touch, cross or cover it:
+// its pieces, each with the discontinuities at its edges and corners and the
+// earlier-or-later patches it coincides with.
+std::vector<Piece> cut_patch(const std::vector<Patch>& patches, size_t p,
+                             const std::vector<std::uint32_t>& near,
+                             const std::vector<double>& diameter, double scene_diameter) {
+  const Patch& patch = patches[p];
+  const Frame f = frame_of(patch);
+  const double thinnest = kThinnest * diameter[p];
+  std::vector<Cut> cuts;
+  std::vector<std::pair<std::uint32_t, std::vector<dvec2>>> coincident;
+  Features features;
+  const double touch_p = kCoincidentScene * scene_diameter;
+  for (std::uint32_t q : near) {
+    Contact c = contact_of(f, diameter[p], patches[q], diameter[q], scene_diameter);
+    // Around a light every piece counts (what lies behind it is bright);
+    // elsewhere a strip narrower than kNarrowest is left uncut.
+    const double narrowest = emits(patches[q]) ? thinnest : kNarrowest * diameter[p];
+    for (const Segment& segment : c.cuts)
+      if (glm::length(segment.b - segment.a) > thinnest) cuts.push_back({segment, narrowest});
+    if (c.meets) features.meetings.push_back({c.cuts[0], c.crosses});
+    if (!c.cover_outline.empty()) {
+      features.covers.push_back(
+          {c.cover_outline, c.gap > std::max(touch_p, kCoincident * diameter[p]) ? c.gap : 0.0});
+      if (c.coincident) coincident.emplace_back(q, std::move(c.cover_outline));
     }
-  });
+  }
+  Polygon2 whole;
+  for (int k = 0; k < patch.corner_count; ++k)
+    whole.push_back(
+        {f.to2(patch.corners[static_cast<size_t>(k)]), patch.corners[static_cast<size_t>(k)]});
+  std::vector<Piece> out;
+  for (Polygon2& polygon : cut_along(whole, std::move(cuts), thinnest)) {
+    Piece piece;
+    const std::vector<dvec2> points = points_of(polygon);
+    piece.area = std::abs(signed_area(points));
+    const dvec2 c = centroid_of(points);
+    piece.centre = f.origin + c.x * f.u + c.y * f.v;
+    for (const auto& [q, outline] : coincident)
+      if (inside(outline, c, thinnest)) piece.coincides_with.push_back(q);
+    mark_discontinuities(piece, polygon, whole, features, c, thinnest);
+    piece.polygon = std::move(polygon);
+    piece.sides = patch.sides;
+    out.push_back(std::move(piece));
+  }
+  return out;
+}
 
-  // Coinciding pieces: the later patch's piece goes into the earlier's.
+// Coinciding pieces: the later patch's piece goes into the earlier's (its
+// merged_into set, its sides given to the earlier piece's where those are
+// missing or dark). Returns the pairs of input faces that are the same
+// surface twice, sorted.
+std::vector<std::array<std::uint32_t, 2>> merge_coincident_pieces(
+    const std::vector<Patch>& patches, std::vector<std::vector<Piece>>& cut,
+    const std::vector<double>& diameter) {
+  const size_t n = patches.size();
   std::vector<size_t> first_piece(n + 1, 0);
   for (size_t p = 0; p < n; ++p) first_piece[p + 1] = first_piece[p] + cut[p].size();
   std::vector<Piece*> flat;
@@ -621,19 +630,31 @@ void mesh_contacts(Scene& scene) {
   }
   std::sort(coincident.begin(), coincident.end());
   coincident.erase(std::unique(coincident.begin(), coincident.end()), coincident.end());
-  scene.coincident = std::move(coincident);
+  return coincident;
+}
 
-  scene.occluders.clear();
-  for (size_t p = 0; p < n; ++p) {
+// The patches as they were before cutting, but for those whose every piece
+// went into another's.
+std::vector<Patch> unmerged_patches(const std::vector<Patch>& patches,
+                                    const std::vector<std::vector<Piece>>& cut) {
+  std::vector<Patch> out;
+  for (size_t p = 0; p < patches.size(); ++p) {
     const bool merged = std::all_of(cut[p].begin(), cut[p].end(),
                                     [](const Piece& piece) { return piece.merged_into >= 0; });
-    if (!merged) scene.occluders.push_back(patches[p]);
+    if (!merged) out.push_back(patches[p]);
   }
+  return out;
+}
+
+// The pieces not merged into others as patches: a patch left whole keeps its
+// corners and takes its piece's sides and discontinuities. The surfaces of
+// the patches cut into several pieces are added to `split_surfaces`.
+std::vector<Patch> patches_of_pieces(const std::vector<Patch>& patches,
+                                     const std::vector<std::vector<Piece>>& cut,
+                                     std::vector<std::uint32_t>& split_surfaces) {
   std::vector<Patch> out;
-  out.reserve(n);
-  scene.split_faces = 0;
-  std::vector<std::uint32_t> split_surfaces;
-  for (size_t p = 0; p < n; ++p) {
+  out.reserve(patches.size());
+  for (size_t p = 0; p < patches.size(); ++p) {
     if (cut[p].size() == 1 && cut[p][0].merged_into < 0) {
       Patch whole = patches[p];
       const Piece& piece = cut[p][0];
@@ -649,10 +670,40 @@ void mesh_contacts(Scene& scene) {
     for (const Piece& piece : cut[p])
       if (piece.merged_into < 0) append_patches(patches[p], piece, out);
   }
+  return out;
+}
+
+}  // namespace
+
+void mesh_contacts(Scene& scene) {
+  std::vector<Patch>& patches = scene.patches;
+  const size_t n = patches.size();
+  if (n < 2) {
+    scene.occluders = patches;
+    return;
+  }
+  const PatchBvh found = patch_bvh(patches);
+  std::vector<double> diameter(n);
+  for (size_t p = 0; p < n; ++p) diameter[p] = diameter_of(patches[p]);
+
+  // Each patch cut on its own, in parallel: deterministic.
+  std::vector<std::vector<Piece>> cut(n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const auto& range) {
+    std::vector<std::uint32_t> near;
+    for (size_t p = range.begin(); p != range.end(); ++p) {
+      const double margin = kCoverGap * diameter[p] + kCoincidentScene * scene.diameter;
+      near_patches(patches, found, p, margin, near);
+      cut[p] = cut_patch(patches, p, near, diameter, scene.diameter);
+    }
+  });
+  scene.coincident = merge_coincident_pieces(patches, cut, diameter);
+
+  scene.occluders = unmerged_patches(patches, cut);
+  std::vector<std::uint32_t> split_surfaces;
+  patches = patches_of_pieces(patches, cut, split_surfaces);
   std::sort(split_surfaces.begin(), split_surfaces.end());
   scene.split_faces = static_cast<size_t>(
       std::unique(split_surfaces.begin(), split_surfaces.end()) - split_surfaces.begin());
-  patches = std::move(out);
 }
 
 }  // namespace radiosity
