@@ -34,7 +34,7 @@ if "bpy" in locals():
     import importlib
     import sys
 
-    for _name in ("compat", "model.arrays", "model.light_units", "model.surface_uv", "model.display_colours",
+    for _name in ("compat", "model.solver_defaults", "model.oracles", "model.arrays", "model.light_units", "model.surface_uv", "model.display_colours",
                   "model.findings", "model.progress_text", "model.quality_meaning", "write.bake_materials",
                   "write.result_state", "read.render_visibility", "read.export", "write.bake",
                   "write.scene_transaction", "write.game_ready", "write.gltf_export", "solve.native",

@@ -26,7 +26,7 @@ import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))
-from solver_bench import BUNDLED, ORACLES, export_bundled, write_results  # noqa: E402
+from solver_bench import BUNDLED, export_bundled, oracles, write_results  # noqa: E402
 
 
 def make_scene(rad, arrays, emission=None, reflectance=None):
@@ -122,7 +122,7 @@ def main():
     rows = []
     for name in ("cube", "office") if args.quick else BUNDLED:
         arrays = dict(np.load(export_bundled(name, args.build, args.blender).path))
-        for oracle in ORACLES:
+        for oracle in oracles(rad):
             for change_name, change in changes(arrays).items():
                 row = dict(scene=name, oracle=oracle, quality=args.quality, change=change_name,
                            **measure(rad, arrays, oracle, args.quality, change, 1 if args.quick else args.repeats))

@@ -19,6 +19,7 @@ first). `--only-generated --faces ...` runs the large-scene curve alone
 
 import argparse
 import csv
+import json
 import pathlib
 import statistics
 import sys
@@ -33,7 +34,11 @@ sys.path.insert(0, str(ROOT / "bench"))
 from synthetic_scenes import SceneBuilder, box_field, room_with_blocker  # noqa: E402
 
 BUNDLED = ("cube", "office", "full_office", "dining_room")
-ORACLES = ("standard", "perceptual", "gradient", "noticeable")
+
+
+def oracles(rad):
+    """Every oracle by the solver's name, in its order (its one table, through DEFAULTS_JSON)."""
+    return tuple(json.loads(rad.DEFAULTS_JSON)["oracles"])
 
 
 class ArrayScene:
@@ -168,7 +173,7 @@ def main():
         scenes.update({"room": room_with_blocker()[0], "office_synthetic": office()})
     qualities = (0.3,) if args.quick else (0.3, 0.5)
     for name, builder in scenes.items():
-        for oracle in ORACLES:
+        for oracle in oracles(rad):
             for quality in qualities:
                 run(name, builder, oracle, quality, args.repeats)
     for faces in ([250] if args.quick else args.faces):

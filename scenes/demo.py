@@ -9,6 +9,7 @@ is loaded from BUILD/addon, as built by `make`.
 """
 
 import argparse
+import json
 import subprocess
 import sys
 import time
@@ -29,7 +30,7 @@ def main():
     parser.add_argument("--build", default="build", help="build directory")
     parser.add_argument("--blender", default="blender", help="Blender executable")
     parser.add_argument("--scene", default="office", choices=sorted(SCENES))
-    parser.add_argument("--oracle", default="PERCEPTUAL", choices=("STANDARD", "PERCEPTUAL", "GRADIENT", "NOTICEABLE"))
+    parser.add_argument("--oracle", default="PERCEPTUAL", help="the oracle's setting, as the solver names it in capitals")
     parser.add_argument("--samples", type=int, default=32, help="Cycles samples of the render")
     parser.add_argument("-v", "--verbose", action="store_true", help="show Blender's output")
     args = parser.parse_args()
@@ -38,6 +39,9 @@ def main():
     addon = build / "addon"
     if not (addon / "radiosity" / "__init__.py").exists():
         sys.exit("error: no add-on in %s; run `make` first" % addon)
+    oracles = json.loads((addon / "radiosity" / "solver_defaults.json").read_text())["oracles"]
+    if args.oracle.lower() not in oracles:
+        parser.error("--oracle must be one of %s" % ", ".join(name.upper() for name in oracles))
     scene_file = build / "scenes" / ("%s.blend" % args.scene)
     out_dir = build / "demo"
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -15,6 +15,8 @@ default width, the detail under it is wrapped (tests/blender/test_addon.py).
 
 import math
 
+from . import oracles
+
 # The patch size the area-weighted oracles' texts speak of: a share of the scene's area.
 PATCH_SHARE = 0.01
 PATCH_WORDS = "1 % of the area"
@@ -38,21 +40,22 @@ def quality_meaning(oracle, threshold):
     `threshold`; the detail says what the headline's number is, or is empty."""
     if not math.isfinite(threshold):
         return "No refinement: the coarsest lighting", ""
-    if oracle == 'NOTICEABLE':
+    name = oracles.name_of(oracle)
+    if name == oracles.NOTICEABLE:
         # The mesh's reconstruction error in just noticeable differences at the receiver.
         return ("Differences below %s JND" % _number(threshold),
                 "about %s %% of the brightness around (1 JND, the least step seen: %d %%)"
                 % (_number(WEBER_PERCENT * threshold), WEBER_PERCENT))
-    if oracle == 'PERCEPTUAL':
+    if name == oracles.PERCEPTUAL:
         # Tangent misses (eq. 28) over the adaptation radiance.
         return ("Shading errors below %s %%" % _number(100.0 * threshold),
                 "of the brightness, where the mesh's straight shading misses the light")
-    if oracle == 'STANDARD':
+    if name == oracles.STANDARD:
         # (L_max - L_min) A_p / (L_ref A): on a patch of share a the brightness a link
         # brings may differ by threshold / a of L_ref from one end to the other.
         return ("Light uneven below %s %%" % _number(100.0 * threshold / PATCH_SHARE),
                 "of the brightness, for one link's light across a patch of %s" % PATCH_WORDS)
-    if oracle == 'GRADIENT':
+    if name == oracles.GRADIENT:
         # |change of slope| A_p / (L_ref sqrt(A)) = (change of slope x side) sqrt(a) / L_ref:
         # the crease a link's light makes across a patch of share a is threshold / sqrt(a).
         return ("Light creases below %s %%" % _number(100.0 * threshold / math.sqrt(PATCH_SHARE)),
@@ -66,5 +69,5 @@ def quality_text(settings, native_module):
     load (the panel says why elsewhere)."""
     if native_module is None:
         return "", ""
-    threshold = native_module.quality_threshold(settings.oracle.lower(), settings.quality)
+    threshold = native_module.quality_threshold(oracles.name_of(settings.oracle), settings.quality)
     return quality_meaning(settings.oracle, threshold)

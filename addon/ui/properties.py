@@ -6,9 +6,6 @@ interface (`scene.radiosity.oracle = 'PERCEPTUAL'`); tests and batch scripts
 rely on them, so they do not change.
 """
 
-import json
-import pathlib
-
 import bpy
 from bpy.props import (
     BoolProperty,
@@ -20,33 +17,8 @@ from bpy.props import (
 )
 from bpy.types import PropertyGroup
 
-# The solver's own defaults and limits (SolveOptions{} in the native core),
-# written into the package when it is built (solver_defaults.json): each is
-# defined once, in C++, and the settings still register when the native
-# module cannot load.
-SOLVER_DEFAULTS = json.loads((pathlib.Path(__file__).parent.parent / "solver_defaults.json").read_text())
-
-# Names are short enough to show uncut at the default Properties width (the
-# Blender tests measure them); descriptions say what a choice does to the
-# picture and the time, with the technical name last.
-ORACLE_ITEMS = (
-    ('STANDARD', "Standard",
-     "Adds detail wherever much light arrives unevenly, whether or not it shows: "
-     "dependable, but spends elements and time on bright areas that already look "
-     "smooth (Hanrahan et al.'s BF refinement)"),
-    ('PERCEPTUAL', "Perceptual",
-     "Adds detail only where the eye would see the shading go wrong, at shadow edges "
-     "and hot spots, and leaves smooth areas coarse: the best picture for the time "
-     "(Secchia 2000, judged from irradiance gradients)"),
-    ('GRADIENT', "Gradient",
-     "Adds detail where the shading changes how quickly it brightens or darkens, as in "
-     "penumbrae and light falloff (irradiance gradient difference)"),
-    ('NOTICEABLE', "Noticeable",
-     "Adds detail where the mesh's shading would differ visibly from the true lighting, "
-     "judged as the eye does: against the brightness around it, and less for details "
-     "too small to resolve. Quality reads as a number of just noticeable differences: "
-     "the fewest elements for a clean picture (Weber contrast on Secchia's gradients)"),
-)
+from ..model import oracles
+from ..model.solver_defaults import SOLVER_DEFAULTS
 
 VISIBILITY_ITEMS = (
     ('EXACT', "Exact",
@@ -149,14 +121,9 @@ class RadiositySettings(PropertyGroup):
 
     oracle: EnumProperty(
         name="Oracle",
-        description=(
-            "Where the lighting gets more detail: where the eye would notice (Perceptual), "
-            "wherever much light varies (Standard), where the shading's slope changes "
-            "(Gradient) or where the mesh would differ visibly from the true lighting "
-            "(Noticeable). Technically, the refinement oracle"
-        ),
-        items=ORACLE_ITEMS,
-        default=SOLVER_DEFAULTS["oracle"].upper(),
+        description=oracles.SETTING_DESCRIPTION,
+        items=oracles.ENUM_ITEMS,
+        default=oracles.identifier(SOLVER_DEFAULTS["oracle"]),
     )
     quality: FloatProperty(
         name="Quality",
@@ -286,7 +253,7 @@ class RadiositySettings(PropertyGroup):
     def solver_options(self):
         """The settings as plain values, the form the native solver takes."""
         return {
-            "oracle": self.oracle.lower(),
+            "oracle": oracles.name_of(self.oracle),
             "quality": self.quality,
             "max_elements": self.max_elements,
             "time_budget": self.time_budget,

@@ -303,11 +303,22 @@ py::dict progress_dict(const SolveProgress& p) {
   return d;
 }
 
+// The oracles' names quoted and joined: "'a', 'b' or 'c'" (`last` "or"), or
+// "'a' | 'b' | 'c'" (`between` and `last` " | ").
+std::string oracle_choices(std::string_view between, std::string_view last) {
+  std::string out;
+  for (size_t i = 0; i < kOracles.size(); ++i) {
+    if (i) out.append(i + 1 == kOracles.size() ? last : between);
+    out.append("'").append(oracle_name(kOracles[i])).append("'");
+  }
+  return out;
+}
+
 Oracle read_oracle(const std::string& name) {
   const auto oracle = parse_oracle(name);
   if (!oracle) {
-    throw std::invalid_argument(
-        "oracle must be 'standard', 'perceptual', 'gradient' or 'noticeable', got '" + name + "'");
+    throw std::invalid_argument("oracle must be " + oracle_choices(", ", " or ") + ", got '" +
+                                name + "'");
   }
   return *oracle;
 }
@@ -667,6 +678,27 @@ void bind_solver(py::module_& m) {
 
   // Defaults from SolveOptions{}: defined once, in the core.
   const SolveOptions defaults;
+  // Kept for the module's life: pybind11 keeps a pointer to the text.
+  static const std::string solve_doc =
+      "Hierarchical radiosity. oracle: " + oracle_choices(" | ", " | ") + "; quality in\n" +
+      "[0, 1] (0: no refinement); max_elements, time_budget (s): budgets; visibility:\n"
+      "'exact' | 'sampled' (rays per sample); bounces: fixed iteration count instead of\n"
+      "convergence; threads; progress(dict) callback; cancel: CancelToken;\n"
+      "leaf_links: 'near' | 'all' | 'none', which links follow a split end down ('all': energy "
+      "to 1e-3);\n"
+      "cluster_separation: clusters of faces this many times their radii apart share one link\n"
+      "(default from quality, 2 to 10; inf: none); memory_limit: bytes the elements and links "
+      "may hold\n"
+      "(default 3/4 of the available memory): refinement stops there (stats['stopped_by'] == "
+      "'memory'),\n"
+      "and a scene that cannot fit unrefined raises MemoryError before any work.\n"
+      "progress gets pass, passes (fixed), phase, elements, leaves, links, seconds and fraction\n"
+      "(never decreasing); with pass_results, the 'pass' reports carry 'result': that pass's\n"
+      "solution, as solve() returns it. yield_to_interface: the solve's threads run at a lower\n"
+      "CPU priority than the process's others (a UI beside the solve). reuse: a SolveReuse;\n"
+      "the solve relights the one it keeps when only the lighting changed (stats['reused']).\n"
+      "clock: a callable giving seconds from any origin, read instead of the steady clock for\n"
+      "time_budget and the reported seconds (tests' fake clock).";
   m.def("solve", &py_solve, py::arg("scene"),
         py::arg("oracle") = std::string(oracle_name(defaults.oracle)),
         py::arg("quality") = defaults.quality, py::arg("max_elements") = py::none(),
@@ -678,27 +710,8 @@ void bind_solver(py::module_& m) {
         py::arg("leaf_links") = std::string(leaf_links_name(defaults.leaf_links)),
         py::arg("cluster_separation") = py::none(), py::arg("memory_limit") = py::none(),
         py::arg("pass_results") = false, py::arg("yield_to_interface") = false,
-        py::arg("reuse") = py::none(), py::arg("clock") = py::none(),
-        "Hierarchical radiosity. oracle: 'standard' | 'perceptual' | 'gradient' |\n"
-        "'noticeable'; quality in\n"
-        "[0, 1] (0: no refinement); max_elements, time_budget (s): budgets; visibility:\n"
-        "'exact' | 'sampled' (rays per sample); bounces: fixed iteration count instead of\n"
-        "convergence; threads; progress(dict) callback; cancel: CancelToken;\n"
-        "leaf_links: 'near' | 'all' | 'none', which links follow a split end down ('all': energy "
-        "to 1e-3);\n"
-        "cluster_separation: clusters of faces this many times their radii apart share one link\n"
-        "(default from quality, 2 to 10; inf: none); memory_limit: bytes the elements and links "
-        "may hold\n"
-        "(default 3/4 of the available memory): refinement stops there (stats['stopped_by'] == "
-        "'memory'),\n"
-        "and a scene that cannot fit unrefined raises MemoryError before any work.\n"
-        "progress gets pass, passes (fixed), phase, elements, leaves, links, seconds and fraction\n"
-        "(never decreasing); with pass_results, the 'pass' reports carry 'result': that pass's\n"
-        "solution, as solve() returns it. yield_to_interface: the solve's threads run at a lower\n"
-        "CPU priority than the process's others (a UI beside the solve). reuse: a SolveReuse;\n"
-        "the solve relights the one it keeps when only the lighting changed (stats['reused']).\n"
-        "clock: a callable giving seconds from any origin, read instead of the steady clock for\n"
-        "time_budget and the reported seconds (tests' fake clock).");
+        py::arg("reuse") = py::none(), py::arg("clock") = py::none(), solve_doc.c_str());
+
   m.def(
       "quality_threshold",
       [](const std::string& oracle, double quality) {

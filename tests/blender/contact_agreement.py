@@ -23,6 +23,7 @@ import sys
 
 import bpy
 import numpy as np
+from radiosity.model import oracles
 
 import image_agreement
 import render_compare as rc
@@ -43,7 +44,7 @@ NOISE_TARGET = dict(exposure=0.003, block=0.01)   # a tenth and a sixth of the t
 MASK_SAMPLES = 16
 # The solution has no noise of its own (emission only): samples anti-alias.
 SOLUTION_SAMPLES = 8
-ORACLES = ("STANDARD", "PERCEPTUAL", "GRADIENT", "NOTICEABLE")
+ORACLES = oracles.IDENTIFIERS
 QUALITIES = (0.3, 0.5, 0.8)
 
 # label: (scene, builder parameters)

@@ -185,6 +185,7 @@ class DefaultsTest(unittest.TestCase):
         bpy.data.scenes.remove(self.settings.id_data)
 
     def test_enum_identifiers(self):
+        # Written out: the identifiers are the scripting interface, which does not change.
         rna = self.settings.bl_rna.properties
         self.assertEqual(list(rna["oracle"].enum_items.keys()),
                          ["STANDARD", "PERCEPTUAL", "GRADIENT", "NOTICEABLE"])

@@ -19,6 +19,7 @@ import bpy
 import numpy as np
 
 import radiosity
+from radiosity.model import oracles
 from radiosity.solve import native, pipeline, solve_reuse
 from radiosity.ui import operators
 from radiosity.write import bake, result_state
@@ -118,7 +119,7 @@ class SolveCubeTest(unittest.TestCase):
         self.assertLess(counts[0.5], counts[0.0] / 2)
 
     def test_every_oracle(self):
-        for oracle in ('STANDARD', 'PERCEPTUAL', 'GRADIENT', 'NOTICEABLE'):
+        for oracle in oracles.IDENTIFIERS:
             with self.subTest(oracle=oracle):
                 scene = open_scene("cube")
                 scene.radiosity.oracle = oracle

@@ -66,7 +66,10 @@ class ModuleTest(unittest.TestCase):
         packaged = pathlib.Path(_radiosity.__file__).with_name("solver_defaults.json")
         defaults = json.loads(_radiosity.DEFAULTS_JSON)
         self.assertEqual(json.loads(packaged.read_text()), defaults)
-        self.assertIn(defaults["oracle"], ("standard", "perceptual", "gradient", "noticeable"))
+        self.assertEqual(defaults["oracles"], ["standard", "perceptual", "gradient", "noticeable"])
+        self.assertIn(defaults["oracle"], defaults["oracles"])
+        for name in defaults["oracles"]:
+            self.assertGreater(_radiosity.quality_threshold(name, 0.5), 0.0)
         self.assertIn(defaults["visibility"], ("exact", "sampled"))
         self.assertTrue(0.0 < defaults["quality"] <= 1.0)
         self.assertTrue(1 <= defaults["rays"] <= defaults["max_rays"])

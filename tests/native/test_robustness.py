@@ -15,7 +15,7 @@ import _radiosity as rad  # noqa: E402
 from synthetic_scenes import SceneBuilder, box_field, room_with_blocker  # noqa: E402
 from work_clock import WorkClock  # noqa: E402
 
-ORACLES = ("standard", "perceptual", "gradient", "noticeable")
+from test_solver import ORACLES  # noqa: E402
 
 
 def open_room(copies=1):

@@ -3,6 +3,7 @@ energy balance, closed-form exchange), refinement where shadows are, invariance,
 crack-free output, validation, cancellation and the ends of the quality range.
 """
 
+import json
 import math
 import os
 import pathlib
@@ -18,7 +19,8 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import _radiosity as rad  # noqa: E402
 from synthetic_scenes import SceneBuilder, box_field, room_with_blocker  # noqa: E402
 
-ORACLES = ("standard", "perceptual", "gradient", "noticeable")
+# Every oracle by the solver's name (its one table, native/core/solve/solve_options.cpp).
+ORACLES = tuple(json.loads(rad.DEFAULTS_JSON)["oracles"])
 
 
 def polygons(result):

@@ -1,35 +1,40 @@
 // The names of the solver's enums at the boundary (radiosity/solve.h): each
 // table is written once here, and the bindings parse and print through it.
 // Also the defaults as JSON, for the add-on's settings.
+#include <array>
 #include <charconv>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "radiosity/solve.h"
 
 namespace radiosity {
 
+namespace {
+
+// Each oracle's name, as solve(oracle=...) takes it and the add-on's settings
+// (in capitals) store it.
+constexpr std::array<std::pair<Oracle, std::string_view>, kOracles.size()> kOracleNames = {{
+    {Oracle::Standard, "standard"},
+    {Oracle::Perceptual, "perceptual"},
+    {Oracle::Gradient, "gradient"},
+    {Oracle::Noticeable, "noticeable"},
+}};
+
+}  // namespace
+
 std::optional<Oracle> parse_oracle(std::string_view name) {
-  if (name == "standard") return Oracle::Standard;
-  if (name == "perceptual") return Oracle::Perceptual;
-  if (name == "gradient") return Oracle::Gradient;
-  if (name == "noticeable") return Oracle::Noticeable;
+  for (const auto& [oracle, oracle_name] : kOracleNames)
+    if (name == oracle_name) return oracle;
   return std::nullopt;
 }
 
 std::string_view oracle_name(Oracle oracle) {
-  switch (oracle) {
-    case Oracle::Standard:
-      return "standard";
-    case Oracle::Perceptual:
-      return "perceptual";
-    case Oracle::Gradient:
-      return "gradient";
-    case Oracle::Noticeable:
-      return "noticeable";
-  }
+  for (const auto& [each, name] : kOracleNames)
+    if (each == oracle) return name;
   return "unknown";
 }
 
@@ -149,7 +154,11 @@ std::string defaults_json() {
       << "  \"min_element_area\": " << number(d.min_element_area) << ",\n"
       << "  \"leaf_links\": \"" << leaf_links_name(d.leaf_links) << "\",\n"
       << "  \"tolerance\": " << number(d.tolerance) << ",\n"
-      << "  \"max_iterations\": " << d.max_iterations << "\n"
+      << "  \"max_iterations\": " << d.max_iterations << ",\n"
+      << "  \"oracles\": [";
+  for (size_t i = 0; i < kOracles.size(); ++i)
+    out << (i ? ", " : "") << "\"" << oracle_name(kOracles[i]) << "\"";
+  out << "]\n"
       << "}\n";
   return out.str();
 }

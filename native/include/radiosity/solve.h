@@ -6,6 +6,7 @@
 // budget, or cancel) with the best complete solution so far.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -45,6 +46,9 @@ enum class Oracle : std::uint8_t {
   // receiver's radiance, fading for elements smaller than the eye resolves.
   Noticeable,
 };
+// Every oracle, in the order the add-on lists them.
+inline constexpr std::array<Oracle, 4> kOracles = {Oracle::Standard, Oracle::Perceptual,
+                                                   Oracle::Gradient, Oracle::Noticeable};
 
 // How partly occluded links see their emitter: the exact visible polygon, or
 // shadow rays.
@@ -129,7 +133,7 @@ enum class RelightRefusal : std::uint8_t {
 
 // The names of the options' and reports' values, as the Python API and the
 // add-on spell them ("perceptual", "exact", "near", "refining", "time_budget"):
-// one table per enum (core/solve/option_names.cpp).
+// one table per enum (core/solve/solve_options.cpp).
 std::optional<Oracle> parse_oracle(std::string_view name);
 std::string_view oracle_name(Oracle oracle);
 std::optional<VisibilityMode> parse_visibility(std::string_view name);
@@ -140,8 +144,9 @@ std::string_view phase_name(SolvePhase phase);
 std::string_view stop_reason_name(StopReason reason);
 std::string_view relight_refusal_name(RelightRefusal refusal);  // "" for None
 
-// SolveOptions{} and the limits as a JSON object, by the names above: the
-// defaults the add-on's settings start from (solver_defaults.json, written at
+// SolveOptions{} and the limits as a JSON object, by the names above, and the
+// oracles' names in kOracles' order ("oracles"): the defaults and choices the
+// add-on's settings start from (solver_defaults.json, written at
 // build time by native/generate/write_defaults.cpp) and `_radiosity.DEFAULTS_JSON`.
 std::string defaults_json();
 
