@@ -31,7 +31,7 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests" / "native"))
 sys.path.insert(0, str(ROOT / "scenes"))
 sys.path.insert(0, str(ROOT / "bench"))
-from synthetic_scenes import SceneBuilder, box_field, room_with_blocker  # noqa: E402
+from synthetic_scenes import SceneBuilder, add_box, box_field, room_with_blocker  # noqa: E402
 
 BUNDLED = ("cube", "office", "full_office", "dining_room")
 
@@ -47,7 +47,7 @@ class ArrayScene:
     def __init__(self, path):
         self.path = path
         self.arrays = np.load(path)
-        self.faces = self.arrays["face_sizes"]
+        self.face_count = len(self.arrays["face_sizes"])
 
     def scene(self, rad):
         a = self.arrays
@@ -76,13 +76,13 @@ def export_bundled(name, build, blender):
 def office(b=None):
     """A 5 x 4 x 3 m office: ceiling light, table with legs, a cabinet."""
     b = b or SceneBuilder()
-    b.box((0, 0, 0), (5, 4, 3), rho=0.6, inward=True)
+    add_box(b, (0, 0, 0), (5, 4, 3), reflectance=0.6, inward=True)
     b.polygon([(2.0, 1.5, 2.99), (2.0, 2.5, 2.99), (3.0, 2.5, 2.99), (3.0, 1.5, 2.99)],
-              rho=0.0, emission=8.0, two_sided=False)
-    b.box((1.8, 1.4, 0.72), (3.2, 2.6, 0.76), rho=(0.5, 0.35, 0.2))  # table top
+              reflectance=0.0, emission=8.0, two_sided=False)
+    add_box(b, (1.8, 1.4, 0.72), (3.2, 2.6, 0.76), reflectance=(0.5, 0.35, 0.2))  # table top
     for x, y in ((1.85, 1.45), (3.1, 1.45), (1.85, 2.5), (3.1, 2.5)):
-        b.box((x, y, 0.0), (x + 0.05, y + 0.05, 0.72), rho=0.3)
-    b.box((0.2, 3.3, 0.0), (1.4, 3.9, 1.8), rho=(0.7, 0.7, 0.75))  # cabinet
+        add_box(b, (x, y, 0.0), (x + 0.05, y + 0.05, 0.72), reflectance=0.3)
+    add_box(b, (0.2, 3.3, 0.0), (1.4, 3.9, 1.8), reflectance=(0.7, 0.7, 0.75))  # cabinet
     return b
 
 
@@ -163,7 +163,7 @@ def main():
     rows = []
 
     def run(name, builder, oracle, quality, repeats, **options):
-        row = dict(scene=name, faces=len(builder.faces), **measure(rad, builder, oracle, quality, repeats, **options))
+        row = dict(scene=name, faces=builder.face_count, **measure(rad, builder, oracle, quality, repeats, **options))
         rows.append(row)
         print(row, flush=True)
 

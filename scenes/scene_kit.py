@@ -14,8 +14,9 @@ diffuse bounces, no clamping.
 
 import numpy as np
 
-# Corners of the unit box, index = x + 2 y + 4 z, each coordinate -0.5 or +0.5.
-_BOX_CORNERS = np.array([[x, y, z] for z in (-0.5, 0.5) for y in (-0.5, 0.5) for x in (-0.5, 0.5)])
+# Which corner of a box each of its 8 corners is, index = x + 2 y + 4 z: 0 at
+# the low corner's coordinate, 1 at the high one's.
+_BOX_CORNERS = np.array([[x, y, z] for z in (0, 1) for y in (0, 1) for x in (0, 1)], dtype=bool)
 # Its faces, counter-clockwise seen from outside.
 BOX_FACES = {
     "bottom": (0, 2, 3, 1),
@@ -36,14 +37,22 @@ def empty_file():
 
 
 def box(size, omit=()):
-    """(vertices, quads) of an axis-aligned box centred on the origin, normals out.
+    """(vertices, quads) of an axis-aligned box centred on the origin, normals out (box_between)."""
+    half = 0.5 * np.asarray(size, dtype=float)
+    return box_between(-half, half, omit)
+
+
+def box_between(lo, hi, omit=(), inward=False):
+    """(vertices (8, 3), quads (k, 4)) of the axis-aligned box from corner `lo` to
+    `hi`: its faces in BOX_FACES' order, normals out, or in (`inward`: a room
+    seen from inside; each quad's corners reversed).
 
     `omit` names faces that touch other surfaces (a leg's top under a table);
     leaving them out keeps coincident, invisible faces out of the solve.
     """
-    verts = _BOX_CORNERS * np.asarray(size, dtype=float)
-    quads = np.array([f for name, f in BOX_FACES.items() if name not in omit])
-    return verts, quads
+    verts = np.where(_BOX_CORNERS, np.asarray(hi, dtype=float), np.asarray(lo, dtype=float))
+    quads = np.array([f for name, f in BOX_FACES.items() if name not in omit]).reshape(-1, 4)
+    return verts, quads[:, ::-1] if inward else quads
 
 
 def quad(origin, u, v):

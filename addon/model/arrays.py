@@ -167,6 +167,12 @@ class SceneBuilder:
         self.part_count += 1
         return part
 
+    def polygon(self, corners, reflectance=0.5, emission=0.0, two_sided=True, occludes=True):
+        """Add one face, its own part, from its corners (n, 3). Returns the face's index."""
+        face = self.face_count
+        self.add(corners, np.arange(len(corners)), [len(corners)], reflectance, emission, two_sided, occludes)
+        return face
+
     @property
     def face_count(self):
         return sum(len(s) for s in self._face_sizes)
@@ -186,6 +192,18 @@ class SceneBuilder:
             "occludes": cat(self._occludes, (0,), bool),
             "face_part": cat(self._face_part, (0,), np.int64),
         }
+
+    def scene(self, solver, lights=None, world=None):
+        """The solver's Scene of the parts added (native_scene)."""
+        return native_scene(solver, self.arrays(), lights, world)
+
+
+def native_scene(solver, scene_arrays, lights=None, world=None):
+    """`solver.Scene` (the native module's) of SceneBuilder.arrays()' dict, with
+    the lights and the world's colour; ValueError where the solver refuses them."""
+    a = scene_arrays
+    return solver.Scene(a["positions"], a["face_vertices"], a["face_sizes"], a["reflectance"], a["emission"],
+                        a["two_sided"], occludes=a["occludes"], lights=lights, world=world)
 
 
 def polygon_normals(positions, face_vertices, face_sizes):

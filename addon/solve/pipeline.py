@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..model import arrays as model_arrays
 from ..model import findings
 from ..read import export
 from ..write import bake, game_ready, result_state, scene_transaction
@@ -146,10 +147,7 @@ def prepare(context, solver, started=None):
                          "Principled Emission) or a world colour"
                          + (" (%s)" % note if note else ""))
     try:
-        native_scene = solver.Scene(arrays["positions"], arrays["face_vertices"], arrays["face_sizes"],
-                                    arrays["reflectance"], arrays["emission"], arrays["two_sided"],
-                                    occludes=arrays["occludes"], lights=exported.lights,
-                                    world=exported.world)
+        native_scene = model_arrays.native_scene(solver, arrays, exported.lights, exported.world)
     except ValueError as err:
         raise SolveError("Radiosity: %s" % err) from None
     settings = scene.radiosity

@@ -54,7 +54,7 @@ def fail(err):
 addon_utils.enable("radiosity", default_set=False, handle_error=fail)
 from radiosity.ui import operators  # noqa: E402  (the add-on, enabled above)
 bpy.context.preferences.system.viewport_aa = 'OFF'  # see above; --factory-startup saves no preferences
-state = {"start": None, "invoke": None, "fractions": [], "by_pass": [], "last_progress": None,
+state = {"start": None, "invoke": None, "fractions": [], "last_progress": None,
          "ticks": 0, "running_seconds": 0.0, "mesh_states": [], "updates_while_running": 0,
          "leaves_after": {}, "clicks": None}
 MARKS = (2.0, 4.0, 6.0)  # seconds after the click at which the refined elements are noted
@@ -147,8 +147,6 @@ def watch():
                 state["leaves_after"][str(mark)] = progress.get("leaves", 0)
         if "fraction" in progress:
             state["fractions"].append(progress["fraction"])
-            state["by_pass"].append([progress.get("pass", 0), progress.get("phase"), progress["fraction"],
-                                     state["running_seconds"]])
             state["last_progress"] = progress
         polygons = result_polygons()
         if polygons and (not state["mesh_states"] or state["mesh_states"][-1] != polygons):
@@ -258,7 +256,7 @@ def check():
         "elements": stats.elements, "results": len(results), "shading": shading,
         "hidden": all(o.hide_render for o in bpy.context.scene.objects
                       if o.type == 'MESH' and not o.get("radiosity_result")),
-        "fractions": state["fractions"], "by_pass": state["by_pass"], "last_progress": state["last_progress"],
+        "fractions": state["fractions"], "last_progress": state["last_progress"],
         "timer_hz": state["ticks"] / max(state["running_seconds"], 1e-9),
         "running_seconds": state["running_seconds"], "updates_while_running": state["updates_while_running"],
         "final_polygons": result_polygons(), "escaped_at": state.get("escaped_at"),

@@ -43,8 +43,11 @@ class InteractiveSolveTest(unittest.TestCase):
 
     def test_passes_show_live_with_a_steady_progress(self):
         # A solve of a furnished room takes seconds: its passes reach the
-        # viewport while it runs, the progress only moves forward, and a UI
-        # timer keeps running.
+        # viewport while it runs, and the progress the window reads only moves
+        # forward. How often the UI timer gets to read it depends on the
+        # machine's speed and load, so no count of its readings is asserted:
+        # that the progress moves within each pass is asserted report by report
+        # in tests/native/test_solver.py (test_progress_moves_within_each_pass).
         shot = os.path.join(SHOTS, "solve_in_progress.png")
         if os.path.exists(shot):
             os.remove(shot)
@@ -53,22 +56,11 @@ class InteractiveSolveTest(unittest.TestCase):
         self.assertGreaterEqual(r["updates_while_running"], 1, r)
         self.assertTrue(os.path.exists(shot), r)  # the window as a pass was shown
         fractions = r["fractions"]
-        self.assertGreater(len(fractions), 3, r)
+        self.assertTrue(fractions, r)
         self.assertEqual(fractions, sorted(fractions), "the progress went back")
-        # And it moves within each pass the timer saw five times or more while
-        # it refined or gathered (it stood at one value while a pass refined
-        # from 376 to 2,623 elements); counted in timer ticks, not seconds.
-        seen = {}
-        for k, phase, fraction, seconds in r["by_pass"]:
-            if phase in ("refining", "gathering"):
-                seen.setdefault(k, []).append((seconds, fraction))
-        long_passes = {k: v for k, v in seen.items() if len(v) >= 5}
-        self.assertTrue(long_passes, seen)
-        for k, v in long_passes.items():
-            self.assertGreater(len({f for _, f in v}), 1, (k, v))
         self.assertGreater(r["final_polygons"], 0)
-        print("interactive full_office: %.1f s, UI timer %.1f Hz (asked 20), %d live updates"
-              % (r["running_seconds"], r["timer_hz"], r["updates_while_running"]))
+        print("interactive full_office: %.1f s, UI timer %.1f Hz (asked 20), %d live updates, %d progress readings"
+              % (r["running_seconds"], r["timer_hz"], r["updates_while_running"], len(fractions)))
         # The timer's rate is printed, not asserted: under the software OpenGL
         # the tests run with, each redraw of the window costs tens of
         # milliseconds and bounds it (measured 7-8.5 Hz of the 20 asked).

@@ -96,6 +96,17 @@ class SceneBuilderTest(unittest.TestCase):
         np.testing.assert_array_equal(a["two_sided"], [True, False, False])
         self.assertEqual(a["reflectance"].max(), 1.0)   # clipped into [0, 1]
 
+    def test_polygons_are_faces_of_their_own(self):
+        b = arrays.SceneBuilder()
+        self.assertEqual(b.polygon([(0, 0, 0), (1, 0, 0), (0, 1, 0)]), 0)
+        self.assertEqual(b.polygon([(0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)], (0.2, 0.3, 0.4), 5.0, False), 1)
+        a = b.arrays()
+        np.testing.assert_array_equal(a["face_vertices"], [0, 1, 2, 3, 4, 5, 6])
+        np.testing.assert_array_equal(a["face_sizes"], [3, 4])
+        np.testing.assert_array_equal(a["reflectance"], [[0.5, 0.5, 0.5], [0.2, 0.3, 0.4]])
+        np.testing.assert_array_equal(a["emission"], [[0, 0, 0], [5, 5, 5]])
+        np.testing.assert_array_equal(a["two_sided"], [True, False])
+
     def test_empty(self):
         a = arrays.SceneBuilder().arrays()
         self.assertEqual(a["positions"].shape, (0, 3))

@@ -12,7 +12,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "native")) 
 
 import _radiosity as rad  # noqa: E402
 from model import findings  # noqa: E402
-from synthetic_scenes import SceneBuilder, room_with_blocker  # noqa: E402
+from synthetic_scenes import SceneBuilder, add_box, native_scene, room_with_blocker  # noqa: E402
 
 
 def broken_faces():
@@ -30,7 +30,7 @@ def broken_faces():
         "Twice": [(1, 3, 1), (2, 3, 1), (2, 3, 1), (2, 3.5, 1), (1, 3.5, 1)],      # a repeated corner
     }
     for name, corners in faults.items():
-        owner[b.polygon(corners, rho=0.5)] = name.rstrip("2")
+        owner[b.polygon(corners, reflectance=0.5)] = name.rstrip("2")
     return b, owner
 
 
@@ -71,11 +71,11 @@ class FaceNotes(unittest.TestCase):
 class CoincidentFaces(unittest.TestCase):
     def test_objects_in_the_same_place_are_named_once_per_pair(self):
         b = SceneBuilder()
-        b.box((0, 0, 0), (4, 4, 3), rho=0.6, inward=True)
-        b.polygon([(1, 1, 2.99), (1, 2, 2.99), (2, 2, 2.99), (2, 1, 2.99)], rho=0.0, emission=5.0, two_sided=False)
-        owner = {f: "Room" for f in range(len(b.faces))}
+        add_box(b, (0, 0, 0), (4, 4, 3), reflectance=0.6, inward=True)
+        b.polygon([(1, 1, 2.99), (1, 2, 2.99), (2, 2, 2.99), (2, 1, 2.99)], reflectance=0.0, emission=5.0, two_sided=False)
+        owner = {f: "Room" for f in range(b.face_count)}
         for name in ("Card", "Copy", "Card"):
-            owner[b.polygon([(1, 1, 1), (2, 1, 1), (2, 2, 1), (1, 2, 1)], rho=0.5)] = name
+            owner[b.polygon([(1, 1, 1), (2, 1, 1), (2, 2, 1), (1, 2, 1)], reflectance=0.5)] = name
         pairs = b.scene(rad).coincident_faces
         self.assertTrue(pairs)
         self.assertEqual(findings.coincident_message(owner.__getitem__, pairs),
@@ -89,13 +89,15 @@ class RelinkReasons(unittest.TestCase):
         reuse = rad.SolveReuse()
         first = rad.solve(b.scene(rad), quality=0.2, reuse=reuse)
         self.assertEqual(findings.relink_reason(first.stats["reuse_refusal"]), "")  # nothing kept: no news
-        b.positions[-1] = b.positions[-1] + np.array([0.0, 0.0, 0.01])
-        moved = rad.solve(b.scene(rad), quality=0.2, reuse=reuse)
+        a = b.arrays()
+        a["positions"][-1] += (0.0, 0.0, 0.01)  # the plate's last corner
+        moved_scene = native_scene(rad, a)
+        moved = rad.solve(moved_scene, quality=0.2, reuse=reuse)
         self.assertEqual(findings.relink_reason(moved.stats["reuse_refusal"]), "the geometry changed")
-        relit = rad.solve(b.scene(rad), quality=0.2, reuse=reuse)
+        relit = rad.solve(moved_scene, quality=0.2, reuse=reuse)
         self.assertTrue(relit.stats["reused"])
         self.assertEqual(findings.relink_reason(relit.stats["reuse_refusal"]), "")
-        changed = rad.solve(b.scene(rad), quality=0.3, reuse=reuse)
+        changed = rad.solve(moved_scene, quality=0.3, reuse=reuse)
         self.assertEqual(findings.relink_reason(changed.stats["reuse_refusal"]), "the quality changed")
 
 

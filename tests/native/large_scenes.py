@@ -1,85 +1,19 @@
 """Large scenes built from arrays in one go (numpy, no per-face Python), for
-the scale benchmark (bench/scale_bench.py) and the scale tests: up to millions
-of faces in seconds.
+scaling runs: up to millions of faces in seconds.
 
-- `box_field(faces)`: many small objects, a 20 x 20 x 4 m room with a ceiling
-  light and a grid of open boxes (five two-sided faces each) on its floor, as
-  synthetic_scenes.box_field builds it face by face.
-- `dense_objects(faces, objects)`: a few dense ones, the same room with
-  `objects` lumpy spheres (icospheres subdivided to about faces / objects
-  triangles each, their radius rippled by a third so each has dents that see
-  one another, as a sculpted or scanned mesh has) standing on the floor.
+- `dense_objects(faces, objects)`: a few dense objects, synthetic_scenes'
+  large_room with `objects` lumpy spheres (icospheres subdivided to about
+  faces / objects triangles each, their radius rippled by a third so each has
+  dents that see one another, as a sculpted or scanned mesh has) standing on
+  the floor.
+- many small objects: synthetic_scenes.box_field.
 
-Each returns a `LargeScene` with the arrays of `_radiosity.Scene`.
+Each returns a SceneBuilder (addon/model/arrays.py).
 """
 
 import numpy as np
 
-ROOM = np.array([20.0, 20.0, 4.0])
-LIGHT = (9.0, 11.0, 3.99)  # a 2 m square ceiling light, 1 cm under the ceiling, emission 10
-
-
-class LargeScene:
-    def __init__(self, positions, faces, sizes, reflectance, emission, two_sided):
-        self.positions = np.ascontiguousarray(positions, float)
-        self.face_vertices = np.ascontiguousarray(faces, np.int64)
-        self.face_sizes = np.ascontiguousarray(sizes, np.int64)
-        self.reflectance = np.ascontiguousarray(reflectance, float)
-        self.emission = np.ascontiguousarray(emission, float)
-        self.two_sided = np.ascontiguousarray(two_sided, bool)
-
-    @property
-    def faces(self):
-        return self.face_sizes
-
-    def scene(self, rad):
-        return rad.Scene(self.positions, self.face_vertices, self.face_sizes, self.reflectance,
-                         self.emission, self.two_sided)
-
-
-def _join(parts):
-    """Concatenates (positions, quads-or-triangles as an (n, k) array, rho, emission, two_sided) parts."""
-    positions, faces, sizes, rho, emission, two = [], [], [], [], [], []
-    base = 0
-    for p, f, r, e, t in parts:
-        positions.append(p)
-        faces.append((f + base).ravel())
-        sizes.append(np.full(len(f), f.shape[1]))
-        rho.append(np.broadcast_to(r, (len(f), 3)))
-        emission.append(np.broadcast_to(e, (len(f), 3)))
-        two.append(np.full(len(f), t))
-        base += len(p)
-    return LargeScene(np.concatenate(positions), np.concatenate(faces), np.concatenate(sizes),
-                      np.concatenate(rho), np.concatenate(emission), np.concatenate(two))
-
-
-def _room():
-    """The room's six walls facing in, and the light facing down."""
-    x, y, z = ROOM
-    corners = np.array([[0, 0, 0], [x, 0, 0], [x, y, 0], [0, y, 0],
-                        [0, 0, z], [x, 0, z], [x, y, z], [0, y, z]], float)
-    walls = np.array([[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [2, 3, 7, 6], [0, 4, 7, 3], [1, 2, 6, 5]])
-    a, b, h = LIGHT
-    light = np.array([[a, a, h], [a, b, h], [b, b, h], [b, a, h]])
-    return [(corners, walls, 0.6, 0.0, False), (light, np.array([[0, 1, 2, 3]]), 0.0, 10.0, False)]
-
-
-# The unit box's corners (index x + 2y + 4z) and its faces but the bottom, outward.
-_CORNERS = np.array([[x, y, z] for z in (0, 1) for y in (0, 1) for x in (0, 1)], float)
-_OPEN_BOX = np.array([[4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]])
-
-
-def box_field(faces):
-    """About `faces` faces: the room and (faces - 7) / 5 open boxes on its floor."""
-    count = max(1, (faces - 7) // 5)
-    side = int(np.ceil(np.sqrt(count)))
-    pitch = 18.0 / side
-    i, j = np.divmod(np.arange(count), side)
-    origin = np.stack([1 + i * pitch, 1 + j * pitch, np.zeros(count)], axis=1)
-    size = 0.5 * pitch
-    positions = (origin[:, None, :] + size * _CORNERS[None]).reshape(-1, 3)
-    quads = (_OPEN_BOX[None] + 8 * np.arange(count)[:, None, None]).reshape(-1, 4)
-    return _join(_room() + [(positions, quads, 0.5, 0.0, True)])
+from synthetic_scenes import large_room
 
 
 def _icosphere(subdivisions):
@@ -115,9 +49,9 @@ def dense_objects(faces, objects=4):
     lumpy = v * ripple[:, None] * 0.5
     lumpy[:, 2] -= lumpy[:, 2].min()  # resting on the floor
     side = int(np.ceil(np.sqrt(objects)))
-    parts = _room()
+    b = large_room()
     for k in range(objects):
         i, j = divmod(k, side)
         at = np.array([10 + 2.5 * (i - (side - 1) / 2), 10 + 2.5 * (j - (side - 1) / 2), 0.0])
-        parts.append((lumpy + at, f, (0.7, 0.5, 0.3), 0.0, False))
-    return _join(parts)
+        b.add(lumpy + at, f.ravel(), np.full(len(f), 3), (0.7, 0.5, 0.3), 0.0, False)
+    return b

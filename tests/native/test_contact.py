@@ -14,7 +14,7 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import _radiosity as rad  # noqa: E402
-from synthetic_scenes import SceneBuilder  # noqa: E402
+from synthetic_scenes import SceneBuilder, add_box  # noqa: E402
 from test_solver import ORACLES, absorbed_power, polygons  # noqa: E402
 
 
@@ -26,10 +26,10 @@ def sealed_lamp_box(plate):
     """A room with a closed box in it, a two-sided lamp 0.01 under the box's lid,
     and (if `plate`) a plate passing through the box's x = 2 wall."""
     b = SceneBuilder()
-    room = b.box((0, 0, 0), (4, 4, 3), rho=0.5, inward=True)
-    box = b.box((1, 1, 0.5), (2, 2, 1.5), rho=0.5)
-    b.polygon([(1.3, 1.7, 1.49), (1.7, 1.7, 1.49), (1.7, 1.3, 1.49), (1.3, 1.3, 1.49)], rho=0.5, emission=10.0)
-    plates = [b.polygon([(1.5, 1.2, 1.0), (2.6, 1.2, 1.0), (2.6, 1.8, 1.0), (1.5, 1.8, 1.0)], rho=0.5)] if plate else []
+    room = add_box(b, (0, 0, 0), (4, 4, 3), reflectance=0.5, inward=True)
+    box = add_box(b, (1, 1, 0.5), (2, 2, 1.5), reflectance=0.5)
+    b.polygon([(1.3, 1.7, 1.49), (1.7, 1.7, 1.49), (1.7, 1.3, 1.49), (1.3, 1.3, 1.49)], reflectance=0.5, emission=10.0)
+    plates = [b.polygon([(1.5, 1.2, 1.0), (2.6, 1.2, 1.0), (2.6, 1.8, 1.0), (1.5, 1.8, 1.0)], reflectance=0.5)] if plate else []
     return b, room, plates
 
 
@@ -38,13 +38,13 @@ def room_with_ceiling_light(gap):
     ceiling, or (gap None) one-sided, filling a hole in the ceiling."""
     b = SceneBuilder()
     rho = 0.6
-    room = b.box((0, 0, 0), (3, 3, 2.5), rho=rho, inward=True, skip=() if gap is not None else (1,))
+    room = add_box(b, (0, 0, 0), (3, 3, 2.5), reflectance=rho, inward=True, omit=() if gap is not None else ("top",))
     if gap is None:
         for x0, x1, y0, y1 in ((0, 3, 0, 1.2), (0, 3, 1.8, 3), (0, 1.2, 1.2, 1.8), (1.8, 3, 1.2, 1.8)):
-            room.append(b.polygon([(x0, y1, 2.5), (x1, y1, 2.5), (x1, y0, 2.5), (x0, y0, 2.5)], rho=rho))
+            room.append(b.polygon([(x0, y1, 2.5), (x1, y1, 2.5), (x1, y0, 2.5), (x0, y0, 2.5)], reflectance=rho))
     z = 2.5 - (gap or 0.0)
     # The lamp reflects, so what it absorbs is counted too.
-    lamp = b.polygon([(1.2, 1.8, z), (1.8, 1.8, z), (1.8, 1.2, z), (1.2, 1.2, z)], rho=0.5, emission=5.0,
+    lamp = b.polygon([(1.2, 1.8, z), (1.8, 1.8, z), (1.8, 1.2, z), (1.2, 1.2, z)], reflectance=0.5, emission=5.0,
                      two_sided=gap is not None)
     return b, room, lamp
 
@@ -122,9 +122,9 @@ def _areas(result):
 class Meshing(unittest.TestCase):
     def test_no_element_straddles_the_footprint_of_a_box_on_the_floor(self):
         b = SceneBuilder()
-        floor = b.polygon([(0, 0, 0), (4, 0, 0), (4, 4, 0), (0, 4, 0)], rho=0.5)
-        b.box((1.3, 1.1, 0), (2.1, 1.9, 0.8), rho=0.5)  # six faces, its bottom on the floor
-        b.polygon([(1, 3, 3), (3, 3, 3), (3, 1, 3), (1, 1, 3)], rho=0.0, emission=5.0, two_sided=False)
+        floor = b.polygon([(0, 0, 0), (4, 0, 0), (4, 4, 0), (0, 4, 0)], reflectance=0.5)
+        add_box(b, (1.3, 1.1, 0), (2.1, 1.9, 0.8), reflectance=0.5)  # six faces, its bottom on the floor
+        b.polygon([(1, 3, 3), (3, 3, 3), (3, 1, 3), (1, 1, 3)], reflectance=0.0, emission=5.0, two_sided=False)
         scene = b.scene(rad)
         self.assertGreaterEqual(scene.split_faces, 1)
         result = rad.solve(scene, oracle="standard", quality=0.3)
@@ -145,9 +145,9 @@ class Meshing(unittest.TestCase):
         # reaches it, so it keeps no links and the output shows each of the
         # box's faces once (its outside), not doubled.
         b = SceneBuilder()
-        b.polygon([(0, 0, 0), (4, 0, 0), (4, 4, 0), (0, 4, 0)], rho=0.5)
-        box = b.box((1.3, 1.1, 0.2), (2.1, 1.9, 0.8), rho=0.5)  # floating: every outer side is lit
-        b.polygon([(1, 3, 3), (3, 3, 3), (3, 1, 3), (1, 1, 3)], rho=0.0, emission=5.0, two_sided=False)
+        b.polygon([(0, 0, 0), (4, 0, 0), (4, 4, 0), (0, 4, 0)], reflectance=0.5)
+        box = add_box(b, (1.3, 1.1, 0.2), (2.1, 1.9, 0.8), reflectance=0.5)  # floating: every outer side is lit
+        b.polygon([(1, 3, 3), (3, 3, 3), (3, 1, 3), (1, 1, 3)], reflectance=0.0, emission=5.0, two_sided=False)
         result = rad.solve(b.scene(rad), oracle="standard", quality=0.3)
         shown = {(int(f), int(s)) for f, s in zip(result.source_face, result.source_side) if f in box}
         self.assertEqual(shown, {(f, 0) for f in box})
@@ -155,10 +155,9 @@ class Meshing(unittest.TestCase):
         # keep 30 links among themselves (each of 6 sides to the 5 others).
         inner_links = rad.solve(b.scene(rad), oracle="standard", quality=0.0).stats["links"]
         b2 = SceneBuilder()
-        b2.polygon([(0, 0, 0), (4, 0, 0), (4, 4, 0), (0, 4, 0)], rho=0.5)
-        for f in b2.box((1.3, 1.1, 0.2), (2.1, 1.9, 0.8), rho=0.5):
-            b2.two_sided[f] = False
-        b2.polygon([(1, 3, 3), (3, 3, 3), (3, 1, 3), (1, 1, 3)], rho=0.0, emission=5.0, two_sided=False)
+        b2.polygon([(0, 0, 0), (4, 0, 0), (4, 4, 0), (0, 4, 0)], reflectance=0.5)
+        add_box(b2, (1.3, 1.1, 0.2), (2.1, 1.9, 0.8), reflectance=0.5, two_sided=False)
+        b2.polygon([(1, 3, 3), (3, 3, 3), (3, 1, 3), (1, 1, 3)], reflectance=0.0, emission=5.0, two_sided=False)
         one_sided_links = rad.solve(b2.scene(rad), oracle="standard", quality=0.0).stats["links"]
         self.assertEqual(inner_links, one_sided_links)
 
@@ -167,13 +166,13 @@ class Meshing(unittest.TestCase):
         # on it uncut; a 40 cm one, or a 20 cm lamp lying on it, is cut around.
         def floor_with(size, emits):
             b = SceneBuilder()
-            b.polygon([(0, 0, 0), (4, 0, 0), (4, 4, 0), (0, 4, 0)], rho=0.5)
-            b.polygon([(1, 3, 3), (3, 3, 3), (3, 1, 3), (1, 1, 3)], rho=0.0, emission=5.0, two_sided=False)
+            b.polygon([(0, 0, 0), (4, 0, 0), (4, 4, 0), (0, 4, 0)], reflectance=0.5)
+            b.polygon([(1, 3, 3), (3, 3, 3), (3, 1, 3), (1, 1, 3)], reflectance=0.0, emission=5.0, two_sided=False)
             if emits:
                 b.polygon([(2, 2, 0.001), (2 + size, 2, 0.001), (2 + size, 2 + size, 0.001), (2, 2 + size, 0.001)],
-                          rho=0.0, emission=5.0, two_sided=False)
+                          reflectance=0.0, emission=5.0, two_sided=False)
             else:
-                b.box((2, 2, 0), (2 + size, 2 + size, 0.5), rho=0.5, skip=(0,))  # no bottom
+                add_box(b, (2, 2, 0), (2 + size, 2 + size, 0.5), reflectance=0.5, omit=("bottom",))  # no bottom
             return b.scene(rad)
         self.assertEqual(floor_with(0.2, emits=False).split_faces, 0)
         self.assertGreaterEqual(floor_with(0.4, emits=False).split_faces, 1)
@@ -182,12 +181,12 @@ class Meshing(unittest.TestCase):
     def test_a_doubled_wall_counts_once_and_is_named(self):
         def room(doubled):
             b = SceneBuilder()
-            walls = b.box((0, 0, 0), (3, 3, 2.5), rho=0.6, inward=True)
+            walls = add_box(b, (0, 0, 0), (3, 3, 2.5), reflectance=0.6, inward=True)
             if doubled:
                 a = b.arrays()
                 start = a["face_vertices"][a["face_sizes"][:2].sum():][:4]
-                walls.append(b.polygon(a["positions"][start], rho=0.6))
-            b.polygon([(1.2, 1.8, 2.49), (1.8, 1.8, 2.49), (1.8, 1.2, 2.49), (1.2, 1.2, 2.49)], rho=0.0,
+                walls.append(b.polygon(a["positions"][start], reflectance=0.6))
+            b.polygon([(1.2, 1.8, 2.49), (1.8, 1.8, 2.49), (1.8, 1.2, 2.49), (1.2, 1.2, 2.49)], reflectance=0.0,
                       emission=5.0, two_sided=False)
             return b
         single, double = room(False), room(True)

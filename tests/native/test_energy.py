@@ -19,7 +19,7 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import _radiosity as rad  # noqa: E402
-from synthetic_scenes import SceneBuilder  # noqa: E402
+from synthetic_scenes import SceneBuilder, add_box  # noqa: E402
 from test_solver import ORACLES, absorbed_power, closed_box  # noqa: E402
 
 QUALITIES = (0.3, 0.5, 0.8)
@@ -35,10 +35,10 @@ def lit_room(rho):
     square one-sided lamp filling a hole in the ceiling (so nothing hides
     behind it)."""
     b = SceneBuilder()
-    b.box((0, 0, 0), (4, 4, 3), rho=rho, inward=True, skip=(1,))
+    add_box(b, (0, 0, 0), (4, 4, 3), reflectance=rho, inward=True, omit=("top",))
     for x0, x1, y0, y1 in ((0, 4, 0, 1.7), (0, 4, 2.3, 4), (0, 1.7, 1.7, 2.3), (2.3, 4, 1.7, 2.3)):
-        b.polygon([(x0, y1, 3), (x1, y1, 3), (x1, y0, 3), (x0, y0, 3)], rho=rho)  # facing down
-    b.polygon([(1.7, 2.3, 3), (2.3, 2.3, 3), (2.3, 1.7, 3), (1.7, 1.7, 3)], rho=rho, emission=LAMP_RADIANCE,
+        b.polygon([(x0, y1, 3), (x1, y1, 3), (x1, y0, 3), (x0, y0, 3)], reflectance=rho)  # facing down
+    b.polygon([(1.7, 2.3, 3), (2.3, 2.3, 3), (2.3, 1.7, 3), (1.7, 1.7, 3)], reflectance=rho, emission=LAMP_RADIANCE,
               two_sided=False)
     return b
 

@@ -15,7 +15,7 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import _radiosity as rad  # noqa: E402
-from synthetic_scenes import SceneBuilder  # noqa: E402
+from synthetic_scenes import SceneBuilder, add_box, scaled_scene  # noqa: E402
 from test_energy import LAMP_RADIANCE, lit_room  # noqa: E402
 from test_robustness import assert_finite  # noqa: E402
 from test_solver import ORACLES, absorbed_power, polygon_areas  # noqa: E402
@@ -29,7 +29,7 @@ def side_irradiance(result, face, side=0):
 
 
 def lamp_over(builder, lo, hi, z, radiance=10.0):
-    builder.polygon([(lo, lo, z), (lo, hi, z), (hi, hi, z), (hi, lo, z)], rho=0.0, emission=radiance,
+    builder.polygon([(lo, lo, z), (lo, hi, z), (hi, hi, z), (hi, lo, z)], reflectance=0.0, emission=radiance,
                     two_sided=False)
 
 
@@ -73,7 +73,7 @@ class Emission(unittest.TestCase):
             reference = rad.solve(b.scene(rad), oracle=oracle)
             for factor in (1e-6, 1e6):
                 with self.subTest(oracle=oracle, factor=factor):
-                    result = rad.solve(b.scene(rad, emission_scale=factor), oracle=oracle)
+                    result = rad.solve(scaled_scene(rad, b, emission_scale=factor), oracle=oracle)
                     assert_finite(self, result)
                     self.assertEqual(result.stats["elements"], reference.stats["elements"])
                     expected = np.asarray(reference.radiance)
@@ -90,9 +90,9 @@ class Sizes(unittest.TestCase):
         for oracle in ORACLES:
             for size in (1e-3, 1.0):
                 b = SceneBuilder()
-                b.box((-500, -500, 0), (500, 500, 100), rho=0.5, inward=True)
+                add_box(b, (-500, -500, 0), (500, 500, 100), reflectance=0.5, inward=True)
                 lamp_over(b, -100, 100, 99)
-                box = b.box((-size / 2, -size / 2, 0), (size / 2, size / 2, size), rho=0.5)
+                box = add_box(b, (-size / 2, -size / 2, 0), (size / 2, size / 2, size), reflectance=0.5)
                 result = rad.solve(b.scene(rad), oracle=oracle)
                 assert_finite(self, result)
                 tops[size] = side_irradiance(result, box[1])
@@ -108,7 +108,7 @@ class Sizes(unittest.TestCase):
             light = {}
             for width in (1e-6, 0.05):
                 b = SceneBuilder()
-                b.box((0, 0, 0), (4, 4, 3), rho=0.5, inward=True)
+                add_box(b, (0, 0, 0), (4, 4, 3), reflectance=0.5, inward=True)
                 lamp_over(b, 1.7, 2.3, 2.99)
                 quad = b.polygon([(1.5, 2, 1e-3), (2.5, 2, 1e-3), (2.5, 2 + width, 1e-3), (1.5, 2 + width, 1e-3)])
                 triangle = b.polygon([(1.5, 2.5, 1e-3), (2.5, 2.5, 1e-3), (2.0, 2.5 + width, 1e-3)])

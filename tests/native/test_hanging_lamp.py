@@ -18,7 +18,7 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import _radiosity as rad  # noqa: E402
-from synthetic_scenes import SceneBuilder  # noqa: E402
+from synthetic_scenes import SceneBuilder, add_box  # noqa: E402
 from test_energy import LAMP_RADIANCE, QUALITIES, tolerance  # noqa: E402
 from test_solver import ORACLES, absorbed_power  # noqa: E402
 
@@ -33,11 +33,11 @@ def hanging_lamp_room(rho, gap, emission=0.0, lamp=LAMP_RADIANCE):
     it, is where the links' form factors summed short of 1 (native/README.md,
     "Energy around a hanging light")."""
     b = SceneBuilder()
-    b.box((0, 0, 0), (4, 4, 3), rho=rho, emission=emission, inward=True)
+    add_box(b, (0, 0, 0), (4, 4, 3), reflectance=rho, emission=emission, inward=True)
     z, lo, hi = 3.0 - gap, 2.0 - LAMP_SIDE / 2, 2.0 + LAMP_SIDE / 2
     down = [(lo, lo, z), (lo, hi, z), (hi, hi, z), (hi, lo, z)]
-    b.polygon(down, rho=rho, emission=emission or lamp, two_sided=False)
-    b.polygon(down[::-1], rho=rho, emission=emission, two_sided=False)
+    b.polygon(down, reflectance=rho, emission=emission or lamp, two_sided=False)
+    b.polygon(down[::-1], reflectance=rho, emission=emission, two_sided=False)
     return b
 
 
@@ -69,9 +69,9 @@ class HangingLampBalance(unittest.TestCase):
         for rho in (0.5, 0.9, 0.99):
             for gap in (0.01, 0.5):
                 b = SceneBuilder()
-                b.box((0, 0, 0), (4, 4, 3), rho=rho, inward=True)
+                add_box(b, (0, 0, 0), (4, 4, 3), reflectance=rho, inward=True)
                 z, lo, hi = 3.0 - gap, 2.0 - LAMP_SIDE / 2, 2.0 + LAMP_SIDE / 2
-                b.polygon([(lo, lo, z), (lo, hi, z), (hi, hi, z), (hi, lo, z)], rho=0.0, emission=LAMP_RADIANCE,
+                b.polygon([(lo, lo, z), (lo, hi, z), (hi, hi, z), (hi, lo, z)], reflectance=0.0, emission=LAMP_RADIANCE,
                           two_sided=False)
                 a = b.arrays()
                 occludes = np.arange(len(a["face_sizes"])) < len(a["face_sizes"]) - 1

@@ -17,7 +17,7 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import _radiosity as rad  # noqa: E402
-from synthetic_scenes import SceneBuilder  # noqa: E402
+from synthetic_scenes import SceneBuilder, add_box  # noqa: E402
 from test_solver import ORACLES, polygon_areas  # noqa: E402
 
 
@@ -31,7 +31,7 @@ def floor(size=4.0, rho=0.5, two_sided=False):
     """A square floor in z = 0 facing up, centred on the origin."""
     b = SceneBuilder()
     h = size / 2
-    b.polygon([(-h, -h, 0), (h, -h, 0), (h, h, 0), (-h, h, 0)], rho=(rho,) * 3, two_sided=two_sided)
+    b.polygon([(-h, -h, 0), (h, -h, 0), (h, h, 0), (-h, h, 0)], reflectance=(rho,) * 3, two_sided=two_sided)
     return b
 
 
@@ -84,7 +84,7 @@ class PointLight(unittest.TestCase):
 
     def test_a_box_casts_a_hard_shadow(self):
         b = floor()
-        b.box((-0.5, -0.5, 0.5), (0.5, 0.5, 0.7), rho=(0.5,) * 3)
+        add_box(b, (-0.5, -0.5, 0.5), (0.5, 0.5, 0.7), reflectance=(0.5,) * 3)
         light = {"type": "point", "position": (0.0, 0.0, 2.0), "intensity": (1.0, 1.0, 1.0)}
         for visibility in ("exact", "sampled"):
             result = rad.solve(scene_of(b, [light]), quality=0.5, visibility=visibility)
@@ -110,7 +110,7 @@ class PointLight(unittest.TestCase):
     def test_scale_invariance(self):
         # Positions x k, intensity x k^2: the same radiance.
         b = floor()
-        b.box((-0.5, -0.5, 0.5), (0.5, 0.5, 0.7), rho=(0.5,) * 3)
+        add_box(b, (-0.5, -0.5, 0.5), (0.5, 0.5, 0.7), reflectance=(0.5,) * 3)
         light = {"type": "point", "position": (0.2, 0.1, 2.0), "intensity": (1.0, 1.0, 1.0), "radius": 0.1}
         base = rad.solve(scene_of(b, [light]), quality=0.5)
         k = 1000.0
@@ -162,7 +162,7 @@ class SpotLight(unittest.TestCase):
 class Sun(unittest.TestCase):
     def test_cosine_and_shadow(self):
         b = floor()
-        b.box((-0.5, -0.5, 0.5), (0.5, 0.5, 0.7), rho=(0.0,) * 3)  # black: no bounce
+        add_box(b, (-0.5, -0.5, 0.5), (0.5, 0.5, 0.7), reflectance=(0.0,) * 3)  # black: no bounce
         tilt = math.radians(30)
         direction = (math.sin(tilt), 0.0, -math.cos(tilt))
         for angle in (0.0, math.radians(2.0)):
@@ -187,7 +187,7 @@ class World(unittest.TestCase):
 
     def test_a_closed_box_sees_no_sky(self):
         b = SceneBuilder()
-        b.box((0, 0, 0), (1, 1, 1), rho=(0.5,) * 3, inward=True)
+        add_box(b, (0, 0, 0), (1, 1, 1), reflectance=(0.5,) * 3, inward=True)
         result = rad.solve(scene_of(b, world=(1.0, 1.0, 1.0)), quality=0.5)
         pos = np.asarray(result.positions)
         # The floor's inner side faces up and sees only the box: no light
@@ -206,10 +206,10 @@ class World(unittest.TestCase):
         # A closed black box with a square hole in its roof: the floor's centre
         # sees the sky through the hole only: H = L_w x F(point -> square).
         b = SceneBuilder()
-        b.box((-1, -1, 0), (1, 1, 1), rho=(0.0,) * 3, inward=True, skip=(1,))
+        add_box(b, (-1, -1, 0), (1, 1, 1), reflectance=(0.0,) * 3, inward=True, omit=("top",))
         for x0, x1, y0, y1 in ((-1, 1, -1, -0.25), (-1, 1, 0.25, 1), (-1, -0.25, -0.25, 0.25), (0.25, 1, -0.25, 0.25)):
-            b.polygon([(x0, y1, 1), (x1, y1, 1), (x1, y0, 1), (x0, y0, 1)], rho=(0.0,) * 3)
-        b.polygon([(-0.1, -0.1, 0.001), (0.1, -0.1, 0.001), (0.1, 0.1, 0.001), (-0.1, 0.1, 0.001)], rho=(0.5,) * 3,
+            b.polygon([(x0, y1, 1), (x1, y1, 1), (x1, y0, 1), (x0, y0, 1)], reflectance=(0.0,) * 3)
+        b.polygon([(-0.1, -0.1, 0.001), (0.1, -0.1, 0.001), (0.1, 0.1, 0.001), (-0.1, 0.1, 0.001)], reflectance=(0.5,) * 3,
                   two_sided=False)
         result = rad.solve(scene_of(b, world=(1.0, 1.0, 1.0)), quality=0.0)
         pos = np.asarray(result.positions)

@@ -105,19 +105,19 @@ def folded_quad_scene():
     b = SceneBuilder()
     # B first: a quad splits along its 0-2 diagonal (as Blender splits it).
     corners = [(2, 0, 0), (2, 2, 1.5), (0, 2, 0), (0, 0, 1.5)]   # B, C, D, A
-    fold = b.polygon(corners, rho=0.5, two_sided=False)
+    fold = b.polygon(corners, reflectance=0.5, two_sided=False)
     centre = np.array([3.2, 3.2, 1.2])
     facing = -np.array([1.0, 1.0, 0.2]) / np.linalg.norm([1.0, 1.0, 0.2])
     u = np.cross(facing, [0.0, 0.0, 1.0])
     u /= np.linalg.norm(u)
     v = np.cross(facing, u)
     light = b.polygon([centre + 0.3 * (su * u + sv * v) for su, sv in ((-1, -1), (1, -1), (1, 1), (-1, 1))],
-                      rho=0.0, emission=20.0)
+                      reflectance=0.0, emission=20.0)
     rng = np.random.default_rng(1)
     start = np.array([0.6, 0.6, 0.6])
     for _ in range(40):
         p = start + (centre - start) * rng.uniform(0.2, 0.8) + rng.normal(0.0, 0.2, 3)
-        b.polygon([p, p + [0.02, 0.0, 0.0], p + [0.0, 0.02, 0.01]], rho=0.5)
+        b.polygon([p, p + [0.02, 0.0, 0.0], p + [0.0, 0.02, 0.01]], reflectance=0.5)
     return b, fold, light
 
 

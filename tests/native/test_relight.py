@@ -74,7 +74,7 @@ class RelightTest(unittest.TestCase):
     def test_a_new_wall_colour_gives_the_light_of_a_solve_from_nothing(self):
         refl = self.builder.arrays()["reflectance"].copy()
         refl[self.parts["room"][2]] = (0.8, 0.2, 0.2)
-        faces = len(self.builder.faces)
+        faces = self.builder.face_count
         for oracle in ORACLES:
             with self.subTest(oracle=oracle):
                 reuse = rad.SolveReuse()
@@ -95,7 +95,7 @@ class RelightTest(unittest.TestCase):
         relit = self.solve("perceptual", reuse, lights=[warm])
         fresh = self.solve("perceptual", lights=[warm])
         self.assertTrue(relit.stats["reused"], relit.stats["reuse_refusal"])
-        faces = len(self.builder.faces)
+        faces = self.builder.face_count
         np.testing.assert_allclose(face_light(relit, faces), face_light(fresh, faces), rtol=0.02)
         # A light with no intensity is no light: turning one on adds a light.
         off = dict(lamp, position=(3.0, 3.0, 2.0), intensity=(0.0, 0.0, 0.0))

@@ -12,7 +12,7 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import _radiosity as rad  # noqa: E402
-from synthetic_scenes import SceneBuilder, box_field, room_with_blocker  # noqa: E402
+from synthetic_scenes import SceneBuilder, add_box, box_field, room_with_blocker, scaled_scene  # noqa: E402
 from work_clock import WorkClock  # noqa: E402
 
 from test_solver import ORACLES  # noqa: E402
@@ -22,10 +22,10 @@ def open_room(copies=1):
     """A 4 x 4 x 3 room without a ceiling, a downward light, and `copies`
     coincident copies of one floating quad (an import with doubled faces)."""
     b = SceneBuilder()
-    b.box((0, 0, 0), (4, 4, 3), rho=0.6, inward=True, skip=(1,))
-    b.polygon([(1.7, 1.7, 2.9), (1.7, 2.3, 2.9), (2.3, 2.3, 2.9), (2.3, 1.7, 2.9)], rho=0.0, emission=5.0,
+    add_box(b, (0, 0, 0), (4, 4, 3), reflectance=0.6, inward=True, omit=("top",))
+    b.polygon([(1.7, 1.7, 2.9), (1.7, 2.3, 2.9), (2.3, 2.3, 2.9), (2.3, 1.7, 2.9)], reflectance=0.0, emission=5.0,
               two_sided=False)
-    quads = [b.polygon([(1, 1, 1), (2, 1, 1), (2, 2, 1), (1, 2, 1)], rho=0.5) for _ in range(copies)]
+    quads = [b.polygon([(1, 1, 1), (2, 1, 1), (2, 2, 1), (1, 2, 1)], reflectance=0.5) for _ in range(copies)]
     return b, quads
 
 
@@ -88,23 +88,18 @@ class BrokenPolygons(unittest.TestCase):
 
     def test_repeated_corners_and_slivers_are_skipped_or_solved_with_a_reason(self):
         b, _ = open_room(0)
-        n = len(b.positions)
-        b.positions.extend(np.array(p, float) for p in [(0, 0, 1), (1, 0, 1), (1, 1e-13, 1), (0, 1, 1.5)])
-        b.faces += [[n, n + 1, n + 1, n + 2], [n, n, n], [n, n + 1, n + 2, n + 3, n + 1]]
-        for _ in range(3):
-            b.reflectance.append(np.full(3, 0.5))
-            b.emission.append(np.zeros(3))
-            b.two_sided.append(True)
+        b.add([(0, 0, 1), (1, 0, 1), (1, 1e-13, 1), (0, 1, 1.5)], [0, 1, 1, 2, 0, 0, 0, 0, 1, 2, 3, 1], [4, 3, 5],
+              0.5, 0.0, True)
         scene = b.scene(rad)
         skipped = {note["face"]: note["kind"] for note in scene.skipped_faces}
-        self.assertEqual(skipped.get(len(b.faces) - 2), "coincident_corners")  # [n, n, n]
+        self.assertEqual(skipped.get(b.face_count - 2), "coincident_corners")  # [n, n, n]
         assert_finite(self, rad.solve(scene, quality=0.5))
 
 
     def test_a_non_planar_quad_is_split_as_blender_splits_it_and_its_bend_is_named(self):
         # A quad with one corner lifted by 0.2.
         b, _ = open_room(0)
-        face = b.polygon([(1, 1, 1), (2, 1, 1), (2, 2, 1.2), (1, 2, 1)], rho=0.5)
+        face = b.polygon([(1, 1, 1), (2, 1, 1), (2, 2, 1.2), (1, 2, 1)], reflectance=0.5)
         scene = b.scene(rad)
         self.assertEqual([(n["face"], n["kind"]) for n in scene.repaired_faces], [(face, "not_planar")])
         note = scene.repaired_faces[0]
@@ -126,9 +121,9 @@ class BrokenPolygons(unittest.TestCase):
 
     def test_repeated_corners_are_removed_and_named(self):
         b, _ = open_room(0)
-        n = len(b.positions)
-        face = b.polygon([(1, 1, 1), (2, 1, 1), (2, 1, 1), (2, 2, 1), (1, 2, 1)], rho=0.5)
-        b.faces[face] = [n, n + 1, n + 2, n + 3, n + 4, n]  # a repeated index too
+        face = b.face_count
+        b.add([(1, 1, 1), (2, 1, 1), (2, 1, 1), (2, 2, 1), (1, 2, 1)], [0, 1, 2, 3, 4, 0],  # a repeated index too
+              [6], 0.5, 0.0, True)
         scene = b.scene(rad)
         self.assertEqual(scene.repaired_faces, [{"face": face, "kind": "repeated_corners", "corners": 2}])
         self.assertEqual(len([p for p in scene.patches if p["sides"][0] and p["sides"][0][0] == face]), 1,
@@ -136,7 +131,7 @@ class BrokenPolygons(unittest.TestCase):
 
     def test_a_bow_tie_is_skipped_with_its_reason_and_the_rest_solves(self):
         b, _ = open_room(0)
-        face = b.polygon([(1, 1, 1), (2, 2, 1), (2, 1, 1), (1, 2, 1)], rho=0.5)
+        face = b.polygon([(1, 1, 1), (2, 2, 1), (2, 1, 1), (1, 2, 1)], reflectance=0.5)
         scene = b.scene(rad)
         self.assertEqual(scene.skipped_faces, [{"face": face, "kind": "crosses_itself"}])
         result = rad.solve(scene, quality=0.3)
@@ -148,11 +143,11 @@ class BrokenPolygons(unittest.TestCase):
         # a 20 m scene, under a white world, made the wall NaN.
         b = SceneBuilder()
         b.polygon([(-7.05, -10.6, -6.46), (-7.05, 7.09, -6.46), (-7.05, 7.09, 7.25), (-7.05, -10.6, 7.25)],
-                  rho=0.8, emission=2.0)
+                  reflectance=0.8, emission=2.0)
         corner = np.array([-6.051289913666132, -2.401285793458587, 1.8345027129815215])
         offsets = [(0, 0, 0), (5.17e-13, 2.64e-13, 5.76e-13), (5.2e-13, 2.86e-13, 6.02e-13), (4.66e-13, 5.1e-13, 8.15e-13)]
-        tiny = b.polygon([corner + o for o in offsets], rho=0.6, emission=1.0)
-        b.polygon([(3.59, 4.06, 6.12), (3.59, 10.8, 6.12), (3.59, 10.8, 4.1), (3.59, 4.06, 4.1)], rho=0.2, emission=1.0)
+        tiny = b.polygon([corner + o for o in offsets], reflectance=0.6, emission=1.0)
+        b.polygon([(3.59, 4.06, 6.12), (3.59, 10.8, 6.12), (3.59, 10.8, 4.1), (3.59, 4.06, 4.1)], reflectance=0.2, emission=1.0)
         a = b.arrays()
         scene = rad.Scene(a["positions"], a["face_vertices"], a["face_sizes"], a["reflectance"], a["emission"],
                           a["two_sided"], world=np.array([40.7, 50.2, 6.9]))
@@ -243,13 +238,13 @@ class OutOfRange(unittest.TestCase):
         light = np.asarray(reference.radiance).sum()
         for scale in (1e-5, 1e25):
             with self.subTest(scale=scale):
-                result = rad.solve(self.builder.scene(rad, scale=scale), quality=0.3)
+                result = rad.solve(scaled_scene(rad, self.builder, scale=scale), quality=0.3)
                 assert_finite(self, result)
                 self.assertAlmostEqual(np.asarray(result.radiance).sum() / light, 1.0, delta=0.01)
         with self.assertRaisesRegex(ValueError, "coordinates beyond"):
-            self.builder.scene(rad, scale=1e31)
+            scaled_scene(rad, self.builder, scale=1e31)
         with self.assertRaisesRegex(ValueError, "scenes smaller than"):
-            self.builder.scene(rad, scale=1e-7)
+            scaled_scene(rad, self.builder, scale=1e-7)
         a = self.builder.arrays()
         with self.assertRaisesRegex(ValueError, "too far for its size"):
             rad.Scene(a["positions"] + 1e7, a["face_vertices"], a["face_sizes"], a["reflectance"], a["emission"])

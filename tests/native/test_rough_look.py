@@ -20,7 +20,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "bench"))
 
 import _radiosity as rad  # noqa: E402
 from solver_bench import office  # noqa: E402
-from synthetic_scenes import room_with_blocker  # noqa: E402
+from synthetic_scenes import add_box, room_with_blocker  # noqa: E402
 from test_energy import LAMP_RADIANCE, lit_room  # noqa: E402
 from test_lights import scene_of  # noqa: E402
 from test_solver import absorbed_power, closed_box, polygon_areas  # noqa: E402
@@ -87,7 +87,7 @@ class RoughLook(unittest.TestCase):
     def test_brightness_within_five_percent_of_the_solved(self):
         # An area light over furniture; a shadowing plate and a box, with a point light too.
         lit = room_with_blocker()[0]
-        lit.box((0.3, 0.3, 0.0), (1.0, 1.0, 0.8), rho=0.4)
+        add_box(lit, (0.3, 0.3, 0.0), (1.0, 1.0, 0.8), reflectance=0.4)
         lights = [{"type": "point", "position": (1.0, 3.0, 2.0), "intensity": (30.0, 25.0, 20.0)}]
         for name, scene in (("office", office().scene(rad)), ("room_with_blocker", lit.scene(rad)),
                             ("point light", scene_of(lit, lights=lights))):

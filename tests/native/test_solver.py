@@ -17,7 +17,7 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import _radiosity as rad  # noqa: E402
-from synthetic_scenes import SceneBuilder, box_field, room_with_blocker  # noqa: E402
+from synthetic_scenes import SceneBuilder, add_box, box_field, room_with_blocker, scaled_scene  # noqa: E402
 
 # Every oracle by the solver's name (its one table, native/core/solve/solve_options.cpp).
 ORACLES = tuple(json.loads(rad.DEFAULTS_JSON)["oracles"])
@@ -57,9 +57,7 @@ def closed_box(rho, emission):
     """The furnace: the inside of a closed box. One-sided, so the unlit outside
     (which emits too, and would be shown at L_e) is not part of the output."""
     b = SceneBuilder()
-    faces = b.box((0, 0, 0), (1, 1.3, 0.8), rho=rho, emission=emission, inward=True)
-    for f in faces:
-        b.two_sided[f] = False
+    add_box(b, (0, 0, 0), (1, 1.3, 0.8), reflectance=rho, emission=emission, inward=True, two_sided=False)
     return b
 
 
@@ -106,12 +104,13 @@ def framed_light_box(rho):
     wall (no gap behind it), a black one-sided window across the opening that
     absorbs what escapes."""
     b = SceneBuilder()
-    walls = b.box((0, 0, 0), (2, 1.5, 1), rho=rho, inward=True, skip=(2,))
-    b.reflectance[walls[1]] = np.full(3, 1e-9)
-    b.two_sided[walls[1]] = False
+    # The top (walls[1]): the black one-sided window.
+    wall, window = np.broadcast_to(rho, 3), np.full(3, 1e-9)
+    walls = add_box(b, (0, 0, 0), (2, 1.5, 1), reflectance=[wall, window, wall, wall, wall], inward=True,
+                    omit=("front",), two_sided=[True, False, True, True, True])
     for x0, x1, z0, z1 in ((0, 2, 0, 0.3), (0, 2, 0.7, 1), (0, 0.5, 0.3, 0.7), (1.5, 2, 0.3, 0.7)):
-        b.polygon([(x0, 0, z0), (x0, 0, z1), (x1, 0, z1), (x1, 0, z0)], rho=rho)
-    b.polygon([(0.5, 0, 0.3), (0.5, 0, 0.7), (1.5, 0, 0.7), (1.5, 0, 0.3)], rho=1e-9, emission=(4, 3, 2),
+        b.polygon([(x0, 0, z0), (x0, 0, z1), (x1, 0, z1), (x1, 0, z0)], reflectance=rho)
+    b.polygon([(0.5, 0, 0.3), (0.5, 0, 0.7), (1.5, 0, 0.7), (1.5, 0, 0.3)], reflectance=1e-9, emission=(4, 3, 2),
               two_sided=False)
     return b, walls[1]
 
@@ -120,10 +119,10 @@ def floating_light_box(rho, gap):
     """The same open box with a whole y = 0 wall, the light `gap` in front of
     it: the light hides part of that wall from the rest of the box."""
     b = SceneBuilder()
-    walls = b.box((0, 0, 0), (2, 1.5, 1), rho=rho, inward=True)
-    b.reflectance[walls[1]] = np.full(3, 1e-9)
-    b.two_sided[walls[1]] = False
-    b.polygon([(0.5, gap, 0.3), (0.5, gap, 0.7), (1.5, gap, 0.7), (1.5, gap, 0.3)], rho=1e-9,
+    wall, window = np.broadcast_to(rho, 3), np.full(3, 1e-9)
+    add_box(b, (0, 0, 0), (2, 1.5, 1), reflectance=[wall, window, wall, wall, wall, wall], inward=True,
+            two_sided=[True, False, True, True, True, True])  # the top: the black window
+    b.polygon([(0.5, gap, 0.3), (0.5, gap, 0.7), (1.5, gap, 0.7), (1.5, gap, 0.3)], reflectance=1e-9,
               emission=(4, 3, 2), two_sided=False)
     return b
 
@@ -134,7 +133,7 @@ LIGHT_POWER = math.pi * np.array([4, 3, 2]) * 0.4
 def box_triangles(lo, hi):
     """The triangles of an axis-aligned box without its bottom, for the visibility API."""
     b = SceneBuilder()
-    b.box(lo, hi, skip=(0,))
+    add_box(b, lo, hi, omit=("bottom",))
     a = b.arrays()
     quads = a["positions"][a["face_vertices"].reshape(-1, 4)]
     return np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
@@ -168,10 +167,10 @@ class EnergyBalance(unittest.TestCase):
         # the samples' average, far more than the exact exchange.
         def floor_gathers(with_box):
             b = SceneBuilder()
-            floor = b.polygon([(0, 0, 0), (20, 0, 0), (20, 20, 0), (0, 20, 0)], rho=0.5, two_sided=False)
-            b.polygon(light, rho=0.0, emission=10.0, two_sided=False)
+            floor = b.polygon([(0, 0, 0), (20, 0, 0), (20, 20, 0), (0, 20, 0)], reflectance=0.5, two_sided=False)
+            b.polygon(light, reflectance=0.0, emission=10.0, two_sided=False)
             if with_box:
-                b.box(*box, rho=1e-9, skip=(0,))
+                add_box(b, *box, reflectance=1e-9, omit=("bottom",))
             result = rad.solve(b.scene(rad), oracle="standard", quality=0.0)
             on_floor = result.source_face == floor
             return (result.irradiance[on_floor, 0] * polygon_areas(result)[on_floor]).sum() / 400.0
@@ -232,8 +231,8 @@ class EmitterSides(unittest.TestCase):
         # emit: the output must show both (a camera above a pendant lamp sees
         # its back), at its emitted radiance.
         b = SceneBuilder()
-        b.box((0, 0, 0), (4, 4, 3), rho=0.6, inward=True)
-        lamp = b.polygon([(1.5, 1.5, 2), (2.5, 1.5, 2), (2.5, 2.5, 2), (1.5, 2.5, 2)], rho=0.0,
+        add_box(b, (0, 0, 0), (4, 4, 3), reflectance=0.6, inward=True)
+        lamp = b.polygon([(1.5, 1.5, 2), (2.5, 1.5, 2), (2.5, 2.5, 2), (1.5, 2.5, 2)], reflectance=0.0,
                          emission=(5, 4, 3), two_sided=True)
         result = rad.solve(b.scene(rad), oracle="standard", quality=0.2)
         polygons_of_lamp = result.source_face == lamp
@@ -280,9 +279,9 @@ class TwoFacingSquares(unittest.TestCase):
     def test_gathered_radiance_matches_closed_form(self):
         for distance in (0.5, 1.0, 3.0):
             b = SceneBuilder()
-            b.polygon([(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)], rho=0.5)  # faces +z
+            b.polygon([(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)], reflectance=0.5)  # faces +z
             b.polygon([(0, 0, distance), (0, 1, distance), (1, 1, distance), (1, 0, distance)],
-                      rho=0.0, emission=2.0, two_sided=False)  # faces -z
+                      reflectance=0.0, emission=2.0, two_sided=False)  # faces -z
             result = rad.solve(b.scene(rad), oracle="standard", quality=0.8)
             receiver = result.source_face == 0
             mean_h = (result.irradiance[receiver] * polygon_areas(result)[receiver, None]).sum(axis=0)
@@ -335,7 +334,7 @@ class Invariance(unittest.TestCase):
         for oracle in ORACLES:
             with self.subTest(oracle=oracle):
                 base = rad.solve(b.scene(rad), oracle=oracle, quality=0.3)
-                scaled = rad.solve(b.scene(rad, scale=1000.0, emission_scale=1e-3), oracle=oracle, quality=0.3)
+                scaled = rad.solve(scaled_scene(rad, b, scale=1000.0, emission_scale=1e-3), oracle=oracle, quality=0.3)
                 self.assertEqual(scaled.stats["elements"], base.stats["elements"])
                 self.assertEqual(scaled.stats["links"], base.stats["links"])
                 # The solver works centred on the scene: a vertex at the origin

@@ -18,7 +18,7 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import _radiosity as rad  # noqa: E402
-from synthetic_scenes import SceneBuilder, room_with_blocker  # noqa: E402
+from synthetic_scenes import SceneBuilder, add_box, room_with_blocker  # noqa: E402
 from test_hanging_lamp import hanging_lamp_room  # noqa: E402
 from test_solver import ORACLES, polygon_areas  # noqa: E402
 
@@ -45,8 +45,8 @@ RADIANCE_TOLERANCE = {"point_and_spot": 2e-3}
 def open_room():
     """The room without its ceiling, and the plate: lit from outside."""
     b = SceneBuilder()
-    b.box((0, 0, 0), (4, 4, 3), rho=0.6, inward=True, skip=(1,))
-    b.polygon([(1.4, 1.4, 1.0), (2.6, 1.4, 1.0), (2.6, 2.6, 1.0), (1.4, 2.6, 1.0)], rho=0.5)
+    add_box(b, (0, 0, 0), (4, 4, 3), reflectance=0.6, inward=True, omit=("top",))
+    b.polygon([(1.4, 1.4, 1.0), (2.6, 1.4, 1.0), (2.6, 2.6, 1.0), (1.4, 2.6, 1.0)], reflectance=0.5)
     return b
 
 
