@@ -1,8 +1,9 @@
 """The same scene in any unit and anywhere (issue 34): a room modelled in
 millimetres or kilometres, or 10 km from the origin, must solve to the same
 light. The solver works in its own frame (scene.h, SolverFrame): positions
-centred on the bounding box and scaled by a power of two, so its tolerances
-and the ray tracer's float32 geometry are the same for all of them.
+centred on the bounding box, scaled to a diameter of 1 and rounded to a grid,
+so its tolerances, its decisions and the ray tracer's float32 geometry are
+the same for all of them.
 
 Radiance has no unit of length: scaling a scene leaves the emission of its
 surfaces as it is, and scales a point or spot light's intensity by the square
@@ -29,17 +30,13 @@ SUN = dict(type="sun", direction=(0.4, 0.3, -1.0), irradiance=(3.0, 3.0, 3.0), a
 SKY = (0.5, 0.6, 0.9)
 
 
-# The refinement turns on decisions that the last bits of the input can tip:
-# the same scene with its coordinates changed by 1e-15 of themselves (what
-# writing them in another unit does) ends with up to 3 % more or fewer
-# elements with the perceptual and gradient oracles, 16 % in the room lit by
-# a point and a spot light (native/README.md, "Units of length").
-ELEMENTS_SPREAD = 0.2
-# Mean radiance within 1e-4 (issue 34), but where point and spot lights light
-# the room: there the mesh those decisions leave (4,831 or 5,627 elements,
-# perceptual) moves the light by up to 1.3e-3 (native/README.md, "Units of
-# length"; still open).
-RADIANCE_TOLERANCE = {"point_and_spot": 2e-3}
+# The solver rounds its frame's positions to a grid of 2^-32 of the scene's
+# diameter (scene.h, SolverFrame), so a scene written in another unit or
+# place is the same numbers inside it: the same mesh, and the same light to
+# rounding (measured: every case within 3e-14). Before the grid, the last
+# bits of the coordinates tipped refinement's decisions: up to 16 % more or
+# fewer elements, 1.3e-3 of the light in the room lit by a point and a spot.
+RADIANCE_TOLERANCE = 1e-10
 
 
 def open_room():
@@ -102,10 +99,8 @@ class UnitsAndPlaces(unittest.TestCase):
                     print("[units] x%g %-14s %-10s: %d / %d elements, mean radiance %+.1e"
                           % (scale, name, oracle, result.stats["elements"], reference.stats["elements"],
                              np.abs(change).max()), flush=True)
-                    np.testing.assert_allclose(change, 0.0, atol=RADIANCE_TOLERANCE.get(name, 1e-4))
-                    # Not yet the same mesh: see ELEMENTS_SPREAD.
-                    self.assertLess(abs(result.stats["elements"] / reference.stats["elements"] - 1),
-                                    ELEMENTS_SPREAD)
+                    np.testing.assert_allclose(change, 0.0, atol=RADIANCE_TOLERANCE)
+                    self.assertEqual(result.stats["elements"], reference.stats["elements"])
 
     def test_a_room_10_km_from_the_origin_solves_as_at_the_origin(self):
         # In float32 a coordinate of 10 km rounds to a millimetre: the lamp's
@@ -118,8 +113,8 @@ class UnitsAndPlaces(unittest.TestCase):
                 print("[units] +10 km %-14s %-10s: %d / %d elements, mean radiance %+.1e"
                       % (name, oracle, result.stats["elements"], reference.stats["elements"],
                          np.abs(change).max()), flush=True)
-                np.testing.assert_allclose(change, 0.0, atol=RADIANCE_TOLERANCE.get(name, 1e-4))
-                self.assertLess(abs(result.stats["elements"] / reference.stats["elements"] - 1), ELEMENTS_SPREAD)
+                np.testing.assert_allclose(change, 0.0, atol=RADIANCE_TOLERANCE)
+                self.assertEqual(result.stats["elements"], reference.stats["elements"])
 
 
 if __name__ == "__main__":
