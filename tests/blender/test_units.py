@@ -1,6 +1,8 @@
 """The same bundled scene modelled in millimetres or kilometres, or 1 km from
 the origin, solves to the same light through the add-on (issue 34; the
-solver's side is tests/native/test_units.py).
+solver's side is tests/native/test_units.py): scaled in the arrays the add-on
+exports, exactly (every oracle); scaled by Blender's transforms, to what their
+float32 rounding allows.
 
 Every object is moved by a transform about the origin; a light's power grows
 with the square of the scale (the same radiance from an area light whose area
@@ -18,27 +20,32 @@ import numpy as np
 from mathutils import Matrix
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "scenes")))
+sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "native")))
 import build_scene  # noqa: E402
+from result_geometry import lit_mean_irradiance  # noqa: E402
 
 TMP = tempfile.mkdtemp(prefix="radiosity-units-")
 SCENES = ("cornell_box", "cube", "lights_room")
 # The default oracle here (every oracle in tests/native/test_units.py: the
 # add-on's part, the export and the bake, is the same for each).
 ORACLE = 'NOTICEABLE'
-# Decisions that the coordinates' rounding can tip (native/README.md, "Units
-# of length"): the mesh is not yet the same to the element, and the light
-# moves with it. Blender keeps transforms in float32, so a scaled scene's
-# coordinates differ by 1e-7 of themselves, not the 1e-16 of the solver's own
-# tests: measured in 3.4, up to 18 % more or fewer elements (the Cornell box)
-# and 2.5e-3 in mean radiance (lights_room).
+# Scaled by its transforms, a scene is not the same numbers: Blender keeps
+# matrices in float32, so a scaled object's coordinates differ by 1e-7 of
+# themselves, well above the solver's grid (2^-32 of the scene's diameter),
+# and refinement's decisions differ with them. Measured in 3.4: up to 14 %
+# more or fewer elements (the Cornell box) and 2.5e-3 in mean radiance
+# (lights_room); the cube, whose coordinates scale exactly, 2,324 elements
+# both ways and 1.6e-9. The same scenes scaled in the exported arrays (float64,
+# ExportedArraysScaled below) solve to the same mesh and light.
 ELEMENTS_SPREAD = 0.2
 SCALED_TOLERANCE = 3e-3
 # Far from the origin Blender rounds an object's location in float32: to a
 # millimetre at 10 km, 0.06 mm at 1 km, where the Cornell box's light hangs
 # 0.1 mm under its ceiling (3,501 or 5,610 elements, 4.3e-3 in mean radiance);
 # and lights_room's point and spot light solution turns on rounding (1.8e-2,
-# native/README.md, "Units of length"). The cube room 1 km away: 2.5e-4. The
-# solver alone keeps a room 10 km away within 2e-7 (tests/native/test_units.py).
+# native/README.md, "Units of length"). The cube room 1 km away: 5.4e-4. The
+# solver alone solves a room 10 km away as at the origin, to 3e-14
+# (tests/native/test_units.py).
 FAR_SCENES = ("cube",)
 FAR_OFFSET = (1e3, -1e3, 2e2)
 FAR_TOLERANCE = 1e-3
@@ -89,6 +96,62 @@ def solved(scene, oracle):
                 total += polygon.area * scale * colour
                 area += polygon.area * scale
     return scene.radiosity.stats.elements, total / area
+
+
+# The bundled rooms, the Cornell box and the lit room, as the add-on exports
+# them; scaled in the exported arrays (float64), where Blender's float32
+# transforms round nothing.
+ARRAY_SCENES = ("cube", "office", "full_office", "dining_room", "cornell_box", "lights_room")
+ARRAY_SCALES = (1e-3, 1e3)
+# Measured 3.4: every oracle, the same element count and the mean radiance
+# within 1e-14 (the solver's grid, scene.h SolverFrame: the scaled scene is the
+# same numbers inside the solver).
+ARRAY_TOLERANCE = 1e-10
+
+
+def exported(name):
+    from radiosity.read import export
+    open_scene(name)
+    return export.export_scene(bpy.context)
+
+
+def solve_arrays(solver, scene, oracle, scale=1.0):
+    """Solves the exported scene with every length times `scale` (a point or
+    spot light's intensity times its square): (elements, area-weighted mean
+    irradiance of the lit polygons)."""
+    a = scene.arrays
+    lights = []
+    for light in scene.lights:
+        light = dict(light)
+        if light["type"] != "sun":
+            light["position"] = np.asarray(light["position"]) * scale
+            light["intensity"] = np.asarray(light["intensity"]) * scale**2
+            light["radius"] *= scale
+        lights.append(light)
+    native_scene = solver.Scene(a["positions"] * scale, a["face_vertices"], a["face_sizes"], a["reflectance"],
+                                a["emission"], a["two_sided"], occludes=a["occludes"], lights=lights,
+                                world=scene.world)
+    result = solver.solve(native_scene, oracle=oracle)
+    return result.stats["elements"], lit_mean_irradiance(result)
+
+
+class ExportedArraysScaled(unittest.TestCase):
+    def test_every_oracle_same_mesh_and_light_in_any_unit(self):
+        from radiosity.model import oracles
+        from radiosity.solve import native
+        solver = native.load()
+        for name in ARRAY_SCENES:
+            scene = exported(name)
+            for oracle in oracles.NAMES:
+                reference = solve_arrays(solver, scene, oracle)
+                for scale in ARRAY_SCALES:
+                    with self.subTest(scene=name, oracle=oracle, scale=scale):
+                        elements, mean = solve_arrays(solver, scene, oracle, scale)
+                        change = np.abs(mean / reference[1] - 1).max()
+                        print("[units] arrays x%g %-12s %-10s: %d / %d elements, mean radiance %+.1e"
+                              % (scale, name, oracle, elements, reference[0], change), flush=True)
+                        self.assertEqual(elements, reference[0])
+                        self.assertLess(change, ARRAY_TOLERANCE)
 
 
 class UnitsAndPlaces(unittest.TestCase):

@@ -17,24 +17,11 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import _radiosity as rad  # noqa: E402
+from result_geometry import polygon_areas, polygons  # noqa: E402
 from synthetic_scenes import SceneBuilder, add_box, box_field, room_with_blocker, scaled_scene  # noqa: E402
 
 # Every oracle by the solver's name (its one table, native/core/solve/solve_options.cpp).
 ORACLES = tuple(json.loads(rad.DEFAULTS_JSON)["oracles"])
-
-
-def polygons(result):
-    """Vertex index arrays of the result's polygons."""
-    offsets = np.concatenate([[0], np.cumsum(result.face_sizes)])
-    return [result.face_vertices[offsets[i]:offsets[i + 1]] for i in range(len(result.face_sizes))]
-
-
-def polygon_areas(result):
-    areas = []
-    for poly in polygons(result):
-        p = result.positions[poly]
-        areas.append(0.5 * np.linalg.norm(np.cross(p[1:-1] - p[0], p[2:] - p[0]).sum(axis=0)))
-    return np.array(areas)
 
 
 def reflected_power(result):

@@ -21,7 +21,8 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import _radiosity as rad  # noqa: E402
 from synthetic_scenes import SceneBuilder, add_box, room_with_blocker  # noqa: E402
 from test_hanging_lamp import hanging_lamp_room  # noqa: E402
-from test_solver import ORACLES, polygon_areas  # noqa: E402
+from result_geometry import lit_mean_irradiance  # noqa: E402
+from test_solver import ORACLES  # noqa: E402
 
 SPOT = dict(type="spot", direction=(0.3, 0.2, -1.0), intensity=(4.0, 3.0, 2.0), radius=0.05,
             cos_half_angle=0.8, blend_width=0.1)
@@ -73,16 +74,6 @@ def moved(builder, lights, scale=1.0, offset=(0.0, 0.0, 0.0)):
                      a["emission"], a["two_sided"], lights=placed, world=sky)
 
 
-def mean_radiance(result):
-    """The area weighted mean gathered H over the lit polygons. A side that sees
-    nothing (the outside of a closed room, the inside of a box) is dark, 1e-4
-    of the light or less, and whether it is output at all turns on links of
-    1e-11 through the room's seams: left out."""
-    areas = polygon_areas(result)
-    lit = result.irradiance.max(axis=1) > 1e-3 * result.irradiance.max()
-    return (result.irradiance[lit] * areas[lit, None]).sum(axis=0) / areas[lit].sum()
-
-
 class UnitsAndPlaces(unittest.TestCase):
     def solve_pairs(self, **placement):
         for name, (builder, lights) in scenes().items():
@@ -95,7 +86,7 @@ class UnitsAndPlaces(unittest.TestCase):
         for scale in (1e-3, 1e3):
             for name, oracle, reference, result in self.solve_pairs(scale=scale):
                 with self.subTest(scale=scale, scene=name, oracle=oracle):
-                    change = mean_radiance(result) / mean_radiance(reference) - 1
+                    change = lit_mean_irradiance(result) / lit_mean_irradiance(reference) - 1
                     print("[units] x%g %-14s %-10s: %d / %d elements, mean radiance %+.1e"
                           % (scale, name, oracle, result.stats["elements"], reference.stats["elements"],
                              np.abs(change).max()), flush=True)
@@ -109,7 +100,7 @@ class UnitsAndPlaces(unittest.TestCase):
         offset = (1e4, -1e4, 5e3)
         for name, oracle, reference, result in self.solve_pairs(offset=offset):
             with self.subTest(scene=name, oracle=oracle):
-                change = mean_radiance(result) / mean_radiance(reference) - 1
+                change = lit_mean_irradiance(result) / lit_mean_irradiance(reference) - 1
                 print("[units] +10 km %-14s %-10s: %d / %d elements, mean radiance %+.1e"
                       % (name, oracle, result.stats["elements"], reference.stats["elements"],
                          np.abs(change).max()), flush=True)
