@@ -311,8 +311,8 @@ Extent measure_extent(const SceneArrays& a, size_t vertex_count) {
 // scene.skipped of why it was left out; its repairs go to scene.repaired.
 // `polygon` holds its corners in the solver's frame, repeated ones removed.
 void add_face(Scene& scene, const SceneArrays& a, size_t f, std::vector<dvec3>& polygon,
-              size_t repeated, const Extent& extent, double smallest_face,
-              std::vector<std::array<size_t, 3>>& triangles) {
+              size_t repeated, double unrounded_diameter, const Extent& extent,
+              double smallest_face, std::vector<std::array<size_t, 3>>& triangles) {
   const auto face = static_cast<std::uint32_t>(f);
   PatchBuilder builder{
       scene,
@@ -323,20 +323,21 @@ void add_face(Scene& scene, const SceneArrays& a, size_t f, std::vector<dvec3>& 
       face};
   const double diameter = polygon_diameter(polygon);
   const dvec3 area_normal = polygon_area_normal(polygon);
+  // Under the smallest face before the grid rounded it (it may have rounded
+  // it to a point).
+  if (unrounded_diameter > 0.0 && unrounded_diameter < smallest_face) {
+    scene.skipped.push_back({.face = face,
+                             .issue = FaceIssue::TooSmall,
+                             .size = unrounded_diameter / extent.frame.scale,
+                             .scene_size = extent.diameter});
+    return;
+  }
   if (polygon.size() < 3 || !(glm::length(area_normal) > kDegenerate * diameter * diameter)) {
     const FaceIssue why = !(diameter > 0.0) ? FaceIssue::CoincidentCorners
                           : turns(polygon, diameter)
                               ? FaceIssue::CrossesItself  // lobes that cancel
                               : FaceIssue::CollinearCorners;
     scene.skipped.push_back({.face = face, .issue = why});
-    return;
-  }
-  if (diameter < smallest_face) {
-    // Its size as the user measures it, for the note.
-    scene.skipped.push_back({.face = face,
-                             .issue = FaceIssue::TooSmall,
-                             .size = diameter / extent.frame.scale,
-                             .scene_size = extent.diameter});
     return;
   }
   std::vector<FaceNote> repairs;
@@ -377,27 +378,31 @@ void add_face(Scene& scene, const SceneArrays& a, size_t f, std::vector<dvec3>& 
 
 // Every input face as patches (add_face), in the solver's frame.
 void add_faces(Scene& scene, const SceneArrays& a, const Extent& extent) {
-  const auto vertex = [&](std::int64_t i) {
+  const auto world = [&](std::int64_t i) {
     const size_t k = static_cast<size_t>(i) * 3;
-    return extent.frame.to_solver(dvec3(a.positions[k], a.positions[k + 1], a.positions[k + 2]));
+    return dvec3(a.positions[k], a.positions[k + 1], a.positions[k + 2]);
   };
   // Faces too small to solve in floating point (scene.h): the input's
   // coordinates carry their rounding at `reach` from the origin.
   const double smallest_face = std::max(kMinRelativeFaceSize * scene.diameter,
                                         kMinFaceSizeOfReach * extent.reach * extent.frame.scale);
   size_t offset = 0;
-  std::vector<dvec3> polygon;
+  std::vector<dvec3> polygon, unrounded;
   std::vector<std::array<size_t, 3>> triangles;
   for (size_t f = 0; f < scene.face_count; ++f) {
     const size_t size = static_cast<size_t>(a.face_sizes[f]);
     polygon.clear();
+    unrounded.clear();
     for (size_t k = 0; k < size; ++k) {
-      const dvec3 v = vertex(a.face_vertices[offset + k]);
+      const dvec3 p = world(a.face_vertices[offset + k]);
+      unrounded.push_back(extent.frame.scaled(p));
+      const dvec3 v = extent.frame.to_solver(p);
       if (polygon.empty() || v != polygon.back()) polygon.push_back(v);
     }
     offset += size;
     while (polygon.size() > 1 && polygon.front() == polygon.back()) polygon.pop_back();
-    add_face(scene, a, f, polygon, size - polygon.size(), extent, smallest_face, triangles);
+    add_face(scene, a, f, polygon, size - polygon.size(), polygon_diameter(unrounded), extent,
+             smallest_face, triangles);
   }
 }
 

@@ -81,9 +81,9 @@ struct SolverFrame {
   static constexpr double kGrid = 4294967296.0;  // 2^32 steps per diameter
   dvec3 origin{0.0};
   double scale = 1.0;
-  dvec3 to_solver(const dvec3& world) const {
-    return glm::round((world - origin) * scale * kGrid) / kGrid;
-  }
+  // Before rounding to the grid: what sizes under a grid step are judged by.
+  dvec3 scaled(const dvec3& world) const { return (world - origin) * scale; }
+  dvec3 to_solver(const dvec3& world) const { return glm::round(scaled(world) * kGrid) / kGrid; }
   dvec3 to_world(const dvec3& solver) const { return solver / scale + origin; }
 };
 
