@@ -3,8 +3,9 @@
 
 Four kinds of tests, run in this order (a fifth on request):
   ctest           the C++ unit tests registered with CTest in the build dir
-  native/test_*   unittest files for the `_radiosity` module (and the study's
-                  `_image_metric`), run by /usr/bin/python3 with build/addon/radiosity
+  native/test_*   unittest files for the `_radiosity` module (and the test-only
+                  `_radiosity_kernels`, the study's `_image_metric`), run by
+                  /usr/bin/python3 with build/addon/radiosity
                   and build/study on sys.path (no Blender); again in each CPython
                   given (--native-python 3.10, repeatable: NATIVE_PYTHONS below, an
                   environment of tools/cpython.py's CPython), which imports the
@@ -69,6 +70,8 @@ NATIVE_PYTHONS = {
 # errors, arrays, threads, relighting's kept state and the package run in every Python.
 NATIVE_ONCE = {
     "test_image_metric.py": "the study's _image_metric is built for Debian's Python alone",
+    "test_kernels.py": "the test-only _radiosity_kernels is built for Debian's Python alone",
+    "test_visibility.py": "the test-only _radiosity_kernels is built for Debian's Python alone",
     "test_solver.py": "the solver's numerics", "test_energy.py": "the solver's energy balance",
     "test_contact.py": "the solver's contact meshing", "test_format.py": "the C++ sources' format",
     "test_rough_look.py": "the ray pass's numerics", "test_units.py": "the solver's frame",

@@ -87,7 +87,7 @@ def build(args, folder):
                         "-DRADIOSITY_PYTHON_VERSION=%s" % version, "-DCMAKE_CXX_FLAGS=%s" % FLAGS],
                        check=True, env=env, stdout=subprocess.DEVNULL)
     subprocess.run(["cmake", "--build", cmake_dir, "-j", str(args.jobs), "--target",
-                    *["fuzz_" + t for t in TARGETS], "_radiosity", "addon"], check=True)
+                    *["fuzz_" + t for t in TARGETS], "_radiosity", "_radiosity_kernels", "addon"], check=True)
     return cmake_dir
 
 
@@ -164,7 +164,7 @@ def run_libfuzzer(name, binary, seconds, folder, results):
 
 # --- Lane 2: atheris and the generators -------------------------------------------------
 
-def run_atheris(python, asan_lib, module_dir, seconds, folder, results):
+def run_atheris(python, asan_lib, module_dirs, seconds, folder, results):
     corpus = folder / "corpus" / "atheris"
     corpus.mkdir(parents=True, exist_ok=True)
     artifacts = folder / "artifacts" / "atheris"
@@ -181,7 +181,8 @@ def run_atheris(python, asan_lib, module_dir, seconds, folder, results):
         while time.monotonic() < deadline - 5:
             rounds += 1
             left = int(deadline - time.monotonic())
-            cmd = [str(python), str(ROOT / "native" / "fuzz" / "atheris_api.py"), "--path", str(module_dir),
+            cmd = [str(python), str(ROOT / "native" / "fuzz" / "atheris_api.py"),
+                   *[option for folder in module_dirs for option in ("--path", str(folder))],
                    "-max_total_time=%d" % left, "-timeout=30", "-rss_limit_mb=4096",
                    "-artifact_prefix=%s/" % artifacts, str(corpus)]
             proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=left + 300)
@@ -208,9 +209,9 @@ def run_atheris(python, asan_lib, module_dir, seconds, folder, results):
     results["atheris (Python API)"] = dict(runs=runs, seconds=seconds, classes=classes, unread=0, log=logfile)
 
 
-def run_generators(asan_lib, module_dir, seconds, first_seed, results):
+def run_generators(asan_lib, module_dirs, seconds, first_seed, results):
     env = dict(os.environ, LD_PRELOAD=str(asan_lib), **SAN_ENV)
-    campaign = fuzz_cases.Campaign([str(module_dir)], jobs=1, timeout=120, env=env, python="/usr/bin/python3")
+    campaign = fuzz_cases.Campaign([str(folder) for folder in module_dirs], jobs=1, timeout=120, env=env, python="/usr/bin/python3")
     deadline = time.monotonic() + seconds
     seed = first_seed
     while time.monotonic() < deadline:
@@ -258,7 +259,8 @@ def main():
     engines = set(args.only.split(","))
     cmake_dir = build(args, folder)
     python, asan_lib = venv(args, folder)
-    module_dir = cmake_dir / "addon" / "radiosity"
+    # _radiosity, and the test-only _radiosity_kernels beside the study's module.
+    module_dirs = [cmake_dir / "addon" / "radiosity", cmake_dir / "study"]
     first_seed = args.seed if args.seed is not None else random.SystemRandom().randrange(10 ** 6, 10 ** 9)
     log("make fuzz: %.0f s; generator seeds from %d; logs and artifacts in %s" % (args.seconds, first_seed, folder))
     results = {}
@@ -271,9 +273,9 @@ def main():
     def lane2():
         both = "atheris" in engines and "generator" in engines
         if "atheris" in engines:
-            run_atheris(python, asan_lib, module_dir, args.seconds / 2 if both else args.seconds, folder, results)
+            run_atheris(python, asan_lib, module_dirs, args.seconds / 2 if both else args.seconds, folder, results)
         if "generator" in engines:
-            run_generators(asan_lib, module_dir, args.seconds / 2 if both else args.seconds, first_seed, results)
+            run_generators(asan_lib, module_dirs, args.seconds / 2 if both else args.seconds, first_seed, results)
 
     threads = [threading.Thread(target=lane1), threading.Thread(target=lane2)]
     for t in threads:

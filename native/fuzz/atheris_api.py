@@ -13,7 +13,8 @@ tools/fuzz.py runs it on a module built with clang and
 -fsanitize=address,undefined,fuzzer-no-link (so libFuzzer sees the C++
 coverage), with atheris' ASan runtime preloaded.
 
-    python atheris_api.py --path DIR_WITH__radiosity [libFuzzer options] [corpus dirs]
+    python atheris_api.py --path DIR_WITH__radiosity --path DIR_WITH__radiosity_kernels \
+        [libFuzzer options] [corpus dirs]
 """
 
 import base64
@@ -46,6 +47,7 @@ with atheris.instrument_imports():
     import fuzz_cases  # noqa: E402  (the output checks the slice uses)
 
 import _radiosity as rad  # noqa: E402
+import _radiosity_kernels  # noqa: E402
 
 np.seterr(all="ignore")
 
@@ -184,7 +186,7 @@ def kernels(fdp):
                             kwargs["faces"] = np.array([fdp.ConsumeIntInRange(0, 3) for _ in range(m)])
                             kwargs["own_faces"] = tuple(fdp.ConsumeIntInRange(0, 3)
                                                         for _ in range(fdp.ConsumeIntInRange(0, 2)))
-            fuzz_cases.run_kernel_call(rad, name, args, kwargs)
+            fuzz_cases.run_kernel_call(rad, _radiosity_kernels, name, args, kwargs)
         except ValueError:
             pass
 

@@ -88,7 +88,7 @@ inline bool valid_polygon(std::span<const dvec3> polygon) {
   return encloses_area(polygon);
 }
 
-// python/bind_visibility.cpp, require_planar_convex.
+// kernels/bind_visibility.cpp, require_planar_convex.
 inline bool planar_convex(std::span<const dvec3> polygon) {
   return planar_convex_problem(polygon) == nullptr;
 }

@@ -5,8 +5,6 @@
 
 namespace radiosity::python {
 
-void bind_kernels(pybind11::module_& m);
-void bind_visibility(pybind11::module_& m);
 void bind_solver(pybind11::module_& m);
 
 }  // namespace radiosity::python

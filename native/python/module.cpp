@@ -11,7 +11,5 @@ namespace py = pybind11;
 PYBIND11_MODULE(_radiosity, m) {
   m.doc() = "Native hierarchical radiosity solver for the Radiosity add-on";
   m.attr("__version__") = RADIOSITY_VERSION;
-  radiosity::python::bind_kernels(m);
-  radiosity::python::bind_visibility(m);
   radiosity::python::bind_solver(m);
 }

@@ -13,7 +13,7 @@ seeds):
   form_factor_gradient, visible_form_factor exact and sampled,
   visible_polygon, quality_threshold) on hostile geometry. Each is a pure
   function of its seed (numpy's PCG64), so a seed is a reproducer.
-- The check. `run_case(rad, kind, seed)` runs one case: each call must give
+- The check. `run_case(rad, kernels, kind, seed)` runs one case: each call must give
   finite, well-formed output or raise ValueError (a clean refusal, counted by
   message class). Anything else is a finding: another exception type,
   non-finite output (positions, radiance, vertex_irradiance, irradiance, F,
@@ -499,8 +499,10 @@ def planar_convex(polygon):
                >= -1e-12 * diameter * diameter for i in range(k))
 
 
-def run_kernel_call(rad, name, args, kwargs):
-    out = getattr(rad, name)(*args, **kwargs)
+def run_kernel_call(rad, kernels, name, args, kwargs):
+    """One call of kernel_case's: quality_threshold of `rad` (_radiosity), the rest
+    of `kernels` (the test-only _radiosity_kernels)."""
+    out = getattr(rad if name == "quality_threshold" else kernels, name)(*args, **kwargs)
     # F to a planar convex polygon (what the solver passes) is a share of the
     # receiver's hemisphere. The kernels take non-planar and concave ones too;
     # what they give then is no F (a concave pentagon across the receiver's
@@ -530,7 +532,7 @@ def run_kernel_call(rad, name, args, kwargs):
             raise Finding("unoccluded F = %r outside [0, 1]" % f)
 
 
-def run_case(rad, kind, seed):
+def run_case(rad, kernels, kind, seed):
     """Runs one case: (calls made, clean ValueErrors by message class, findings).
 
     A scene case is one Scene() and solve(); a kernel case is kernel_case(seed)'s
@@ -549,7 +551,7 @@ def run_case(rad, kind, seed):
     calls = kernel_case(seed)
     for index, (name, args, kwargs) in enumerate(calls):
         try:
-            run_kernel_call(rad, name, args, kwargs)
+            run_kernel_call(rad, kernels, name, args, kwargs)
         except ValueError as err:
             errors["%s: %s" % (name, message_class(err))] += 1
         except Finding as err:
@@ -575,6 +577,7 @@ def worker(paths):
     for p in paths:
         sys.path.insert(0, p)
     import _radiosity as rad  # noqa: E402
+    from kernels_module import kernels  # noqa: E402  (None where not built: no kernel cases then)
     # stderr is for what a crash leaves: Python's traceback at the fault, a
     # sanitizer's report; not for numpy's warnings about hostile generated values.
     faulthandler.enable()
@@ -583,7 +586,7 @@ def worker(paths):
     for line in sys.stdin:
         kind, seed = line.split()
         seed = int(seed)
-        calls, errors, findings = run_case(rad, kind, seed)
+        calls, errors, findings = run_case(rad, kernels, kind, seed)
         reply = {"seed": seed, "calls": calls, "errors": dict(errors), "findings": findings}
         sys.stdout.write(json.dumps(reply) + "\n")
         sys.stdout.flush()
@@ -708,15 +711,16 @@ class Campaign:
             lines.append("FINDING x%d (%s) %s" % (len(cases), kind, key))
             for seed, what in cases[:examples]:
                 lines.append("  seed %d: %s" % (seed, what.replace("\n", "\n    ")))
-                lines.append("    reproduce: python3 tests/native/fuzz_cases.py --path BUILD/addon/radiosity %s %d"
-                             % (kind, seed))
+                lines.append("    reproduce: python3 tests/native/fuzz_cases.py --path BUILD/addon/radiosity "
+                             "--path BUILD/study %s %d" % (kind, seed))
         return "\n".join(lines)
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--worker", action="store_true", help="answer `KIND SEED` lines on stdin")
-    parser.add_argument("--path", action="append", default=[], help="directory holding _radiosity")
+    parser.add_argument("--path", action="append", default=[],
+                        help="directory holding _radiosity or _radiosity_kernels (repeatable)")
     parser.add_argument("--show", action="store_true", help="print the case's arguments")
     parser.add_argument("kind", nargs="?", choices=["scene", "kernel"])
     parser.add_argument("seed", nargs="?", type=int)
@@ -729,10 +733,11 @@ def main(argv=None):
     for p in args.path:
         sys.path.insert(0, p)
     import _radiosity as rad  # noqa: E402
+    import _radiosity_kernels as kernels  # noqa: E402
     if args.show:
         np.set_printoptions(precision=17, threshold=10 ** 6)
         print(scene_case(args.seed) if args.kind == "scene" else kernel_case(args.seed))
-    calls, errors, findings = run_case(rad, args.kind, args.seed)
+    calls, errors, findings = run_case(rad, kernels, args.kind, args.seed)
     print("%d call(s); clean ValueErrors: %s" % (calls, dict(errors)))
     for what in findings:
         print("FINDING: %s" % what)

@@ -26,10 +26,12 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import _radiosity as rad  # noqa: E402
 from fuzz_cases import Campaign  # noqa: E402
+from kernels_module import MISSING, kernels  # noqa: E402
 
 SCALE = float(os.environ.get("FUZZ_SLICE_SCALE", "1"))
 SCENES = int(round(2000 * SCALE))
-KERNEL_CASES = int(round(1000 * SCALE))  # 10 calls each
+# 10 calls each, of the test-only _radiosity_kernels: none where it is not built.
+KERNEL_CASES = int(round(1000 * SCALE)) if kernels is not None else 0
 # A case is a small scene solved with at most a few hundred elements: well under a
 # second. Sixty seconds is a hang, even on a loaded machine.
 TIMEOUT = float(os.environ.get("FUZZ_CASE_TIMEOUT", "60"))
@@ -42,8 +44,10 @@ KNOWN_OPEN = {}
 
 class FuzzSlice(unittest.TestCase):
     def test_generated_cases(self):
-        module_dir = str(pathlib.Path(rad.__file__).resolve().parent)
-        campaign = Campaign([module_dir], jobs=2, timeout=TIMEOUT)
+        module_dirs = [str(pathlib.Path(module.__file__).resolve().parent) for module in (rad, kernels) if module]
+        campaign = Campaign(module_dirs, jobs=2, timeout=TIMEOUT)
+        if kernels is None:
+            print("[summary] no kernel cases: %s" % MISSING, flush=True)
         # Interleaved, so both kinds run even when a slow machine is watched closely.
         cases = []
         for i in range(max(SCENES, KERNEL_CASES)):

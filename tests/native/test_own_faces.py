@@ -24,6 +24,7 @@ import unittest
 import numpy as np
 
 import _radiosity as rad
+from kernels_module import MISSING, kernels
 from synthetic_scenes import SceneBuilder
 
 # The receiver point lies on wing A of face 0, whose wing B, folded along their
@@ -50,14 +51,15 @@ def occluders(*parts):
     return np.array(triangles), np.array(faces)
 
 
+@unittest.skipIf(kernels is None, MISSING)
 class VisibleFormFactor(unittest.TestCase):
     def setUp(self):
-        self.unoccluded, _ = rad.form_factor_gradient(POINT, NORMAL, EMITTER)
+        self.unoccluded, _ = kernels.form_factor_gradient(POINT, NORMAL, EMITTER)
         self.assertGreater(self.unoccluded, 0.05)
 
     def f(self, parts, mode, own_faces=(0, 1)):
         triangles, faces = occluders(*parts)
-        value, _ = rad.visible_form_factor(POINT, NORMAL, EMITTER, triangles, mode=mode, rays=RAYS,
+        value, _ = kernels.visible_form_factor(POINT, NORMAL, EMITTER, triangles, mode=mode, rays=RAYS,
                                            faces=faces, own_faces=own_faces)
         return value
 
@@ -94,7 +96,7 @@ class VisibleFormFactor(unittest.TestCase):
                                 (dict(faces=faces, own_faces=[0, 1, 2]), "own_faces"),
                                 (dict(faces=faces, own_faces=[-3]), "own_faces")):
             with self.assertRaisesRegex(ValueError, message):
-                rad.visible_form_factor(POINT, NORMAL, EMITTER, triangles, mode="sampled", **kwargs)
+                kernels.visible_form_factor(POINT, NORMAL, EMITTER, triangles, mode="sampled", **kwargs)
 
 
 def folded_quad_scene():

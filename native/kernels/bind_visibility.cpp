@@ -19,7 +19,7 @@
 #include "core/visibility/ray_scene.h"
 #include "core/visibility/sampled_visibility.h"
 #include "core/visibility/visible_polygon.h"
-#include "python/bindings.h"
+#include "kernels/bindings.h"
 #include "python/numpy_input.h"
 #include "radiosity/solve.h"
 
@@ -84,6 +84,25 @@ std::array<std::uint32_t, 2> read_own_faces(const py::handle& object) {
   return own;
 }
 
+// What both functions read: a receiver point and normal, a planar convex
+// emitter and occluder triangles.
+struct VisibilityInput {
+  dvec3 point, normal;
+  std::vector<dvec3> emitter;
+  std::vector<Triangle> occluders;
+};
+
+VisibilityInput read_visibility_input(const py::handle& point, const py::handle& normal,
+                                      const py::handle& emitter, const py::handle& occluders) {
+  VisibilityInput in;
+  in.point = read_point(point, "point");
+  in.normal = read_unit_vec3(normal, "normal");
+  in.emitter = read_polygon(emitter, "emitter");
+  require_planar_convex(in.emitter, "emitter");
+  in.occluders = read_triangles(occluders, "occluders");
+  return in;
+}
+
 py::array_t<double> to_numpy(const std::vector<dvec3>& points) {
   py::array_t<double> out({static_cast<py::ssize_t>(points.size()), py::ssize_t{3}});
   auto w = out.mutable_unchecked<2>();
@@ -101,11 +120,8 @@ void bind_visibility(py::module_& m) {
       [](const py::handle& point, const py::handle& normal, const py::handle& emitter,
          const py::handle& occluders, const std::string& mode, int rays, const py::handle& faces,
          const py::handle& own_faces) {
-        const dvec3 r = read_point(point, "point");
-        const dvec3 n = read_unit_vec3(normal, "normal");
-        const std::vector<dvec3> polygon = read_polygon(emitter, "emitter");
-        require_planar_convex(polygon, "emitter");
-        const std::vector<Triangle> triangles = read_triangles(occluders, "occluders");
+        const auto [r, n, polygon, triangles] =
+            read_visibility_input(point, normal, emitter, occluders);
         const std::vector<std::uint32_t> face = read_faces(faces, triangles.size());
         const std::array<std::uint32_t, 2> own = read_own_faces(own_faces);
         const std::optional<VisibilityMode> visibility = parse_visibility(mode);
@@ -149,11 +165,8 @@ void bind_visibility(py::module_& m) {
       "visible_polygon",
       [](const py::handle& point, const py::handle& normal, const py::handle& emitter,
          const py::handle& occluders) {
-        const dvec3 r = read_point(point, "point");
-        const dvec3 n = read_unit_vec3(normal, "normal");
-        const std::vector<dvec3> polygon = read_polygon(emitter, "emitter");
-        require_planar_convex(polygon, "emitter");
-        const std::vector<Triangle> triangles = read_triangles(occluders, "occluders");
+        const auto [r, n, polygon, triangles] =
+            read_visibility_input(point, normal, emitter, occluders);
         VisiblePolygon visible;
         {
           py::gil_scoped_release release;

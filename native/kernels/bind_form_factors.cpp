@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "core/geometry/form_factor.h"
-#include "python/bindings.h"
+#include "kernels/bindings.h"
 #include "python/numpy_input.h"
 
 namespace py = pybind11;
@@ -32,7 +32,7 @@ KernelInput read_kernel_input(const py::handle& point, const py::handle& normal,
 
 }  // namespace
 
-void bind_kernels(py::module_& m) {
+void bind_form_factors(py::module_& m) {
   m.def(
       "form_factor",
       [](const py::handle& point, const py::handle& normal, const py::handle& polygon) {
