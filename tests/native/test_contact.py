@@ -15,7 +15,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import _radiosity as rad  # noqa: E402
 from synthetic_scenes import SceneBuilder, add_box  # noqa: E402
-from test_solver import ORACLES, absorbed_power, polygons  # noqa: E402
+from test_solver import ORACLES, absorbed_power, polygon_areas, polygons  # noqa: E402
 
 
 def centres(result):
@@ -98,7 +98,7 @@ class LightUnderCeiling(unittest.TestCase):
                     pocket = (np.abs(c[:, 0] - 1.5) < 0.3) & (np.abs(c[:, 1] - 1.5) < 0.3) & (c[:, 2] > 2.5 - 1e-6)
                     open_room = np.isin(result.source_face, room) & ~pocket
                     power = math.pi * ((1 - 0.6) * result.irradiance[open_room, 0] *
-                                       _areas(result)[open_room]).sum()
+                                       polygon_areas(result)[open_room]).sum()
                     print("[contact] %s gap %.0e m: room absorbs %.4f of the flush lamp's" % (oracle, gap, power / flush_power))
                     # Some of the pocket's light does leave through the gap: a
                     # point of the pocket sees the gap with a form factor of
@@ -109,14 +109,6 @@ class LightUnderCeiling(unittest.TestCase):
                     e = 4 * 0.6 * gap / (2 * 0.36)
                     self.assertGreaterEqual(power / flush_power, 0.995)
                     self.assertLess(power / flush_power, 1.0 + 1.5 * e / (1 - 0.55 * (1 - e)))
-
-
-def _areas(result):
-    out = []
-    for p in polygons(result):
-        q = result.positions[p]
-        out.append(0.5 * np.linalg.norm(np.cross(q[1:-1] - q[0], q[2:] - q[0]).sum(axis=0)))
-    return np.array(out)
 
 
 class Meshing(unittest.TestCase):

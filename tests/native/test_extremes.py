@@ -52,6 +52,8 @@ class Reflectance(unittest.TestCase):
     def test_an_almost_white_room_keeps_its_light(self):
         # rho = 0.999: a light bounces about a thousand times before it is
         # absorbed; what the walls absorb still equals what the lamp emits.
+        # Measured: 0.9990 to 0.9991, every oracle (0.990 to 0.999 before the
+        # sending side counted the receiving correction, energy_balance.cpp).
         emitted = math.pi * LAMP_RADIANCE * 0.36
         for oracle in ORACLES:
             with self.subTest(oracle=oracle):
@@ -61,7 +63,7 @@ class Reflectance(unittest.TestCase):
                 ratio = absorbed_power(b, result)[0] / emitted
                 print("[white room] rho 0.999 %-10s: absorbed / emitted %.5f, %d elements, %d iterations"
                       % (oracle, ratio, result.stats["elements"], result.stats["iterations"]), flush=True)
-                self.assertAlmostEqual(ratio, 1.0, delta=1e-2)
+                self.assertAlmostEqual(ratio, 1.0, delta=3e-3)
 
 
 class Emission(unittest.TestCase):

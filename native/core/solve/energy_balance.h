@@ -34,7 +34,10 @@
 // sum(A C) / sum(A D) over R: the deviation from the mean leaves in the
 // proportion the leaf's closure asks, the mean in the proportion R's links
 // carry as a whole, so that R delivers sum(A_l C_l L_l), and a uniformly
-// bright surface (the furnace) is sent unchanged. Inner elements send the
+// bright surface (the furnace) is sent unchanged. D_l is what the receivers'
+// leaves gather from l, the receiving correction's factors included: else the
+// light that correction adds is made at every bounce (a white room with a box,
+// lit by a light that casts no shadow: 13 % at rho 0.99). Inner elements send the
 // area average of their leaves. Surfaces that reflect nothing are not
 // balanced on either side: they have no receiver links to know a closure by,
 // and an emitter's own light is uniform.
