@@ -161,7 +161,7 @@ BLOCK_TOLERANCE = 0.06
 NOISE_FRACTION = 0.25
 
 
-def assert_agreement(test, label, qualities=QUALITIES, oracles=ORACLES, mean_tolerance=MEAN_TOLERANCE):
+def assert_agreement(test, label, qualities=QUALITIES, oracles=ORACLES):
     """Asserts (on `test`, a TestCase) that each of `oracles` at `qualities` agrees with the
     path trace of the case `label` within the tolerances, printing the numbers."""
     scene = build_case(label)
@@ -185,9 +185,9 @@ def assert_agreement(test, label, qualities=QUALITIES, oracles=ORACLES, mean_tol
                   flush=True)
             numbers = "%s %s q=%.1f: exposure %+.1f %% (tolerance %.0f %%), median block error %.1f %% " \
                       "(tolerance %.0f %%)" % (label, oracle.lower(), quality, 100 * e["exposure"],
-                                               100 * mean_tolerance, 100 * e["block"], 100 * BLOCK_TOLERANCE)
+                                               100 * MEAN_TOLERANCE, 100 * e["block"], 100 * BLOCK_TOLERANCE)
             with test.subTest(oracle=oracle, quality=quality):
-                test.assertLess(abs(e["exposure"]), mean_tolerance, numbers)
+                test.assertLess(abs(e["exposure"]), MEAN_TOLERANCE, numbers)
                 test.assertLess(e["block"], BLOCK_TOLERANCE, numbers)
     folder = os.environ.get("RADIOSITY_TEST_IMAGES")
     if folder:

@@ -36,7 +36,7 @@ EmitterShape emitter_shape(const Hierarchy& hierarchy, const Element& emitter,
   double mean = 0.0;
   for (int c = 0; c < 4; ++c) {
     f[c] = form_factor(x[c], normal, receiver_polygon);
-    mean += 0.25 * f[c];
+    mean += area_share(hierarchy, emitter, c) * f[c];
   }
   if (!(mean > 0.0) || !std::isfinite(mean)) return kUniformShape;
   EmitterShape shape;
@@ -51,8 +51,9 @@ Rgb sent_radiance(const Hierarchy& hierarchy, std::int32_t emitter,
   Rgb sum(0.0);
   double weight = 0.0;
   for (int c = 0; c < 4; ++c) {
-    // Area shares are a quarter each; the weights' sum renormalises half-precision rounding.
-    const double w = static_cast<double>(shape[static_cast<size_t>(c)]);
+    // The weights' sum also renormalises half-precision rounding.
+    const double w =
+        static_cast<double>(shape[static_cast<size_t>(c)]) * area_share(hierarchy, e, c);
     sum += w * radiance[static_cast<size_t>(e.first_child + c)];
     weight += w;
   }

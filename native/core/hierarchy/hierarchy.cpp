@@ -89,15 +89,43 @@ Rgb Interpolant::at_child_sample(int corner_count, const std::array<Rgb, kMaxSam
   return glm::max(Rgb(sum), Rgb(0.0));
 }
 
-Rgb Interpolant::average(int corner_count, const std::array<Rgb, kMaxSamples>& values) {
+AverageWeights Interpolant::uniform_weights(int corner_count) {
   // Integrals over the element of the bubbles: 16 u(1-u) v(1-v) -> 4/9, and
   // 27 l0 l1 l2 -> 9/20 (of the area); the corners share the rest equally.
   const double bubble = corner_count == 4 ? 4.0 / 9.0 : 9.0 / 20.0;
-  glm::dvec3 corners(0.0);
-  for (int k = 0; k < corner_count; ++k) corners += glm::dvec3(values[static_cast<size_t>(k)]);
-  corners /= corner_count;
-  return Rgb((1 - bubble) * corners +
-             bubble * glm::dvec3(values[static_cast<size_t>(corner_count)]));
+  AverageWeights w{};
+  for (int k = 0; k < corner_count; ++k) w[static_cast<size_t>(k)] = (1 - bubble) / corner_count;
+  w[static_cast<size_t>(corner_count)] = bubble;
+  return w;
+}
+
+AverageWeights Interpolant::quad_weights(const std::array<double, 4>& corner_density) {
+  // The density J is bilinear in (u, v) through its corner values J_m, so
+  // the integral of the interpolant times J is exact with the integrals of
+  // products of the bilinear basis: 1/9 (same corner), 1/18 (corners along
+  // an edge), 1/36 (opposite corners); and of the bubble times each basis
+  // function, 1/9. Over the area (sum J_m / 4), with j_m = J_m over their
+  // mean: corner k's weight sum_m M_km j_m less its share of the bubble's
+  // bilinear part, 1/9; the centre's stays 4/9.
+  const double mean =
+      0.25 * (corner_density[0] + corner_density[1] + corner_density[2] + corner_density[3]);
+  if (!(mean > 0.0)) return uniform_weights(4);
+  AverageWeights w{};
+  for (size_t k = 0; k < 4; ++k) {
+    const double same = corner_density[k], opposite = corner_density[(k + 2) % 4];
+    const double along = corner_density[(k + 1) % 4] + corner_density[(k + 3) % 4];
+    w[k] = (same / 9.0 + along / 18.0 + opposite / 36.0) / mean - 1.0 / 9.0;
+  }
+  w[4] = 4.0 / 9.0;
+  return w;
+}
+
+Rgb Interpolant::average(const AverageWeights& weights, int corner_count,
+                         const std::array<Rgb, kMaxSamples>& values) {
+  glm::dvec3 sum(0.0);
+  for (int k = 0; k <= corner_count; ++k)
+    sum += weights[static_cast<size_t>(k)] * glm::dvec3(values[static_cast<size_t>(k)]);
+  return Rgb(sum);
 }
 
 namespace {
@@ -165,6 +193,21 @@ Hierarchy::Hierarchy(const Scene& scene) : scene_(&scene) {
 int Hierarchy::corners(const Element& e, dvec3* out) const {
   for (int k = 0; k < e.corner_count; ++k) out[k] = vertices_[e.corner[static_cast<size_t>(k)]];
   return e.corner_count;
+}
+
+AverageWeights Hierarchy::average_weights(const Element& e) const {
+  if (e.corner_count != 4) return Interpolant::uniform_weights(e.corner_count);
+  dvec3 c[4];
+  corners(e, c);
+  // The bilinear map's area density at each corner: the cross product of the
+  // two edges leaving it, measured along the quad's normal (its diagonals').
+  const dvec3 up = glm::cross(c[2] - c[0], c[3] - c[1]);
+  std::array<double, 4> density{};
+  for (size_t k = 0; k < 4; ++k) {
+    const dvec3 next = c[(k + 1) % 4] - c[k], previous = c[k] - c[(k + 3) % 4];
+    density[k] = glm::dot(glm::cross(previous, next), up);
+  }
+  return Interpolant::quad_weights(density);
 }
 
 dvec3 Hierarchy::centre(const Element& e) const {
@@ -269,6 +312,16 @@ std::int32_t Hierarchy::subdivide(std::int32_t index) {
   }
   const auto first = static_cast<std::int32_t>(elements_.size());
   for (int k = 0; k < 4; ++k) {
+    // A triangle's four children are congruent; a quad's are the parts of its
+    // bilinear map, equal only in a parallelogram (a floor piece cut around a
+    // rotated box, counted as quarters, took or gave its wide end's light:
+    // 3.6 % of a spot's direct light).
+    const auto& corner = children[static_cast<size_t>(k)];
+    const double area =
+        parent.corner_count == 4
+            ? 0.5 * glm::length(glm::cross(vertices_[corner[2]] - vertices_[corner[0]],
+                                           vertices_[corner[3]] - vertices_[corner[1]]))
+            : parent.area / 4;
     Element child;
     child.corner = children[static_cast<size_t>(k)];
     child.parent = index;
@@ -276,7 +329,7 @@ std::int32_t Hierarchy::subdivide(std::int32_t index) {
     child.side = parent.side;
     child.corner_count = parent.corner_count;
     child.has_links = parent.has_links;
-    child.area = parent.area / 4;
+    child.area = area;
     child.radiance = parent.radiance;
     elements_.push_back(child);
   }

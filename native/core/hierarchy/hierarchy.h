@@ -34,6 +34,30 @@ struct Element {
   bool is_leaf() const { return first_child == kNone; }
 };
 
+// Weights of an element's samples (corners, then centre) in the area average
+// of its interpolant: what the element gathers in all is its area times
+// sum_k w[k] v[k].
+using AverageWeights = std::array<double, kMaxSamples>;
+
+// The element's interpolant of sample values (DESIGN s5): bilinear or
+// barycentric through the corners plus a bubble that vanishes on the edges and
+// matches the centre sample. Continuous across edges.
+struct Interpolant {
+  // Value at child `c`'s sample `s` of a parent with `corner_count` corners
+  // (clamped at zero).
+  static Rgb at_child_sample(int corner_count, const std::array<Rgb, kMaxSamples>& values, int c,
+                             int s);
+  // Average weights where area is spread evenly over the parameters: every
+  // triangle, and quads that are parallelograms.
+  static AverageWeights uniform_weights(int corner_count);
+  // A quad's average weights, from its area density at the corners (the
+  // bilinear map's Jacobian, Hierarchy::average_weights): a quad that is not a
+  // parallelogram gives the parameters near its wide end more area.
+  static AverageWeights quad_weights(const std::array<double, 4>& corner_density);
+  static Rgb average(const AverageWeights& weights, int corner_count,
+                     const std::array<Rgb, kMaxSamples>& values);
+};
+
 class Hierarchy {
  public:
   explicit Hierarchy(const Scene& scene);
@@ -61,6 +85,13 @@ class Hierarchy {
 
   // Corner positions, counter-clockwise about the side's normal.
   int corners(const Element& e, dvec3* out) const;
+  // The area average of the element's interpolant (Interpolant), over its
+  // true area: the four children of a quad that is not a parallelogram differ
+  // in area, and so do the parts of each.
+  AverageWeights average_weights(const Element& e) const;
+  Rgb average(const Element& e, const std::array<Rgb, kMaxSamples>& values) const {
+    return Interpolant::average(average_weights(e), e.corner_count, values);
+  }
   dvec3 centre(const Element& e) const;
   double diameter(const Element& e) const;
   // Sample points: corners pulled towards the centre by a millionth of the
@@ -101,19 +132,6 @@ class Hierarchy {
   std::vector<dvec3> vertices_;
   std::vector<std::int32_t> roots_;
   std::unordered_map<std::uint64_t, std::uint32_t> midpoints_;
-};
-
-// The element's interpolant of sample values (DESIGN s5): bilinear or
-// barycentric through the corners plus a bubble that vanishes on the edges and
-// matches the centre sample. Continuous across edges.
-struct Interpolant {
-  // Value at child `c`'s sample `s` of a parent with `corner_count` corners
-  // (clamped at zero).
-  static Rgb at_child_sample(int corner_count, const std::array<Rgb, kMaxSamples>& values, int c,
-                             int s);
-  // Area average of the interpolant (the weights that integrate it exactly in
-  // parameter space).
-  static Rgb average(int corner_count, const std::array<Rgb, kMaxSamples>& values);
 };
 
 }  // namespace radiosity

@@ -310,7 +310,7 @@ OutputMesh make_output_mesh(const Hierarchy& h,
     mesh.face_sizes.push_back(static_cast<std::int32_t>(mesh.face_vertices.size() - polygon_start));
     mesh.source_face.push_back(static_cast<std::int32_t>(h.side_of(e).face));
     mesh.source_side.push_back(h.side_of(e).face_side);
-    const Rgb mean = glm::max(Interpolant::average(e.corner_count, leaf_irradiance[i]), Rgb(0.0));
+    const Rgb mean = glm::max(h.average(e, leaf_irradiance[i]), Rgb(0.0));
     mesh.irradiance.insert(
         mesh.irradiance.end(),
         {static_cast<float>(mean.x), static_cast<float>(mean.y), static_cast<float>(mean.z)});

@@ -1,6 +1,7 @@
 // Scenes for the C++ tests, built from arrays as the Python API builds them.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -30,6 +31,16 @@ struct Arrays {
     reflectance.insert(reflectance.end(), {rho, rho, rho});
     emission.insert(emission.end(), {emit, emit, emit});
     two_sided.push_back(both_sides ? 1 : 0);
+  }
+  // A planar quad through four corners (counter-clockwise about its front).
+  void quad(const std::array<dvec3, 4>& corners, double rho, double emit) {
+    const auto base = static_cast<std::int64_t>(positions.size() / 3);
+    for (const dvec3& p : corners) positions.insert(positions.end(), {p.x, p.y, p.z});
+    for (int k = 0; k < 4; ++k) faces.push_back(base + k);
+    sizes.push_back(4);
+    reflectance.insert(reflectance.end(), {rho, rho, rho});
+    emission.insert(emission.end(), {emit, emit, emit});
+    two_sided.push_back(0);
   }
   Scene scene() const {
     return make_scene({positions, faces, sizes, reflectance, emission, two_sided, {}, {}, {}});

@@ -53,12 +53,10 @@ std::vector<SampleWeights> gathering_weights(const Hierarchy& h,
     const Element& x = elements[e];
     const int samples = x.sample_count();
     if (x.is_leaf()) {
-      for (int k = 0; k < samples; ++k) {
-        SampleRgb basis{};
-        basis[static_cast<size_t>(k)] = Rgb(1.0);
-        w[e][static_cast<size_t>(k)] = x.area * Interpolant::average(x.corner_count, basis).x *
+      const AverageWeights average = h.average_weights(x);
+      for (int k = 0; k < samples; ++k)
+        w[e][static_cast<size_t>(k)] = x.area * average[static_cast<size_t>(k)] *
                                        static_cast<double>(down[e][static_cast<size_t>(k)]);
-      }
       continue;
     }
     for (int k = 0; k < samples; ++k) {
@@ -97,7 +95,7 @@ std::vector<double> delivered_fractions(const Hierarchy& h, const std::vector<Li
     const Element& q = h.element(l.emitter);
     SampleRgb f{};
     for (size_t s = 0; s < kMaxSamples; ++s) f[s] = Rgb(static_cast<double>(l.form_factor[s]));
-    double power = p.area * Interpolant::average(p.corner_count, f).x;  // A_p F_pq = A_q F_qp
+    double power = p.area * h.average(p, f).x;  // A_p F_pq = A_q F_qp
     if (!p.is_leaf()) {
       power = 0.0;
       for (int k = 0; k < p.sample_count(); ++k)
@@ -108,8 +106,10 @@ std::vector<double> delivered_fractions(const Hierarchy& h, const std::vector<Li
       delivered[static_cast<size_t>(l.emitter)] += power / q.area;
       continue;
     }
+    // What each child sends is its shape times its area share (sent_radiance).
     double weights = 0.0;
-    for (_Float16 w : l.emitter_shape) weights += static_cast<double>(w);
+    for (int c = 0; c < 4; ++c)
+      weights += static_cast<double>(l.emitter_shape[static_cast<size_t>(c)]) * area_share(h, q, c);
     if (!(weights > 0.0)) {
       delivered[static_cast<size_t>(l.emitter)] += power / q.area;
       continue;
@@ -117,8 +117,7 @@ std::vector<double> delivered_fractions(const Hierarchy& h, const std::vector<Li
     for (int c = 0; c < 4; ++c) {
       const std::int32_t child = q.first_child + c;
       delivered[static_cast<size_t>(child)] +=
-          power * static_cast<double>(l.emitter_shape[static_cast<size_t>(c)]) / weights /
-          h.element(child).area;
+          power * static_cast<double>(l.emitter_shape[static_cast<size_t>(c)]) / weights / q.area;
     }
   }
   if (!far.empty()) {
@@ -272,7 +271,7 @@ void EnergyBalance::update(const Hierarchy& h, const LinkGather& grouping, const
         down_scale_[e][k] = static_cast<float>(scale);
         received[k] = own[k] + scale * down;
       }
-      const Rgb mean = Interpolant::average(x.corner_count, received);
+      const Rgb mean = h.average(x, received);
       // At most the whole hemisphere: where the samples say more, it is the
       // energy correction of a link (link_transport) showing at a point.
       receiving[e] = trust * std::clamp(1.0 - (mean.x - mean.y) - escaped, 0.0, 1.0) +

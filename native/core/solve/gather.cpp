@@ -32,9 +32,10 @@ std::array<SampleRgb, 4> push_to_children(const Hierarchy& h, const Element& e,
     SampleRgb& child = down[static_cast<size_t>(c)];
     for (int s = 0; s <= corners; ++s)
       child[static_cast<size_t>(s)] = Interpolant::at_child_sample(corners, total, c, s);
-    pushed += h.element(e.first_child + c).area * glm::dvec3(Interpolant::average(corners, child));
+    const Element& part = h.element(e.first_child + c);
+    pushed += part.area * glm::dvec3(h.average(part, child));
   }
-  const Rgb shift = Interpolant::average(corners, total) - Rgb(pushed / e.area);
+  const Rgb shift = h.average(e, total) - Rgb(pushed / e.area);
   for (SampleRgb& child : down)
     for (int s = 0; s <= corners; ++s) child[static_cast<size_t>(s)] += shift;
   return down;
@@ -96,8 +97,7 @@ Rgb PushPull::operator()(std::int32_t index, const SampleRgb& down, Change& chan
     for (size_t s = 0; s < kMaxSamples; ++s) total[s] += direct[static_cast<size_t>(index)][s];
   Rgb radiance;
   if (e.is_leaf()) {
-    radiance = h.emission(e) +
-               h.reflectance(e) * glm::max(Interpolant::average(e.corner_count, total), Rgb(0.0));
+    radiance = h.emission(e) + h.reflectance(e) * glm::max(h.average(e, total), Rgb(0.0));
     change.delta += std::abs(luminance(radiance) - luminance(e.radiance)) * e.area;
     change.total += luminance(radiance) * e.area;
     if (leaf_out) (*leaf_out)[static_cast<size_t>(index)] = total;

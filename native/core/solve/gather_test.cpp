@@ -96,12 +96,13 @@ TEST(PushToChildren, KeepsThePowerOfAVaryingGather) {
   double pushed = 0.0;
   for (int c = 0; c < 4; ++c) {
     const Element& child = s.h.element(parent.first_child + c);
-    pushed += child.area * Interpolant::average(child.corner_count, down[static_cast<size_t>(c)]).x;
+    pushed += child.area * s.h.average(child, down[static_cast<size_t>(c)]).x;
   }
-  const double expected = parent.area * Interpolant::average(parent.corner_count, total).x;
+  const double expected = parent.area * s.h.average(parent, total).x;
   EXPECT_NEAR(pushed, expected, 1e-12 * expected);
   // Uneven: the children do not all receive the same.
-  EXPECT_NE(Interpolant::average(4, down[0]).x, Interpolant::average(4, down[2]).x);
+  EXPECT_NE(s.h.average(s.h.element(parent.first_child), down[0]).x,
+            s.h.average(s.h.element(parent.first_child + 2), down[2]).x);
 }
 
 TEST(GatheredAtLeaves, MatchesWhatPushPullUses) {

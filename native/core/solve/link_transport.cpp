@@ -151,18 +151,19 @@ double grid_visible_share(const LinkEnds& ends, int corner_count,
 }
 
 // The interpolant's average of per-sample values: what the receiver gathers.
-double sample_average(int corner_count, const double* value) {
-  std::array<Rgb, kMaxSamples> v{};
-  for (int s = 0; s <= corner_count; ++s) v[static_cast<size_t>(s)] = Rgb(value[s]);
-  return Interpolant::average(corner_count, v).x;
+double sample_average(const AverageWeights& weights, int corner_count, const double* value) {
+  double sum = 0.0;
+  for (int s = 0; s <= corner_count; ++s) sum += weights[static_cast<size_t>(s)] * value[s];
+  return sum;
 }
 
 // Returns how much more light occluders hide at one sample than at another
 // (the largest open-minus-visible form factor over the samples less the
 // smallest): a shadow's edge lies between them, and the light beside it
 // reaches about the open value, which the samples' reconstruction cannot show.
-double conserve_energy(const Element& receiver, const LinkEnds& ends, bool unoccluded,
-                       SampleValues& values, const std::span<const Triangle>* grid_occluders) {
+double conserve_energy(const Element& receiver, const AverageWeights& weights, const LinkEnds& ends,
+                       bool unoccluded, SampleValues& values,
+                       const std::span<const Triangle>* grid_occluders) {
   std::array<Rgb, kMaxSamples> open{}, in_front{};
   double visible[kMaxSamples] = {};
   double hidden_most = 0.0, hidden_least = std::numeric_limits<double>::infinity();
@@ -179,8 +180,8 @@ double conserve_energy(const Element& receiver, const LinkEnds& ends, bool unocc
     hidden_least = std::min(hidden_least, hidden);
   }
   const double shadow_contrast = hidden_most - std::min(hidden_least, hidden_most);
-  const double average = Interpolant::average(receiver.corner_count, open).x;
-  const double front = Interpolant::average(receiver.corner_count, in_front).x;
+  const double average = Interpolant::average(weights, receiver.corner_count, open).x;
+  const double front = Interpolant::average(weights, receiver.corner_count, in_front).x;
   // 1e-6: far pairs need fewer quadrature points than the kernel's default
   // (7 x 7 instead of 5 x 5 at a gap of three radii for 1e-8, which changed
   // no energy test's result beyond 1e-7).
@@ -199,7 +200,7 @@ double conserve_energy(const Element& receiver, const LinkEnds& ends, bool unocc
       const double share = grid_visible_share(ends, receiver.corner_count, *grid_occluders);
       std::array<Rgb, kMaxSamples> seen{};
       for (int s = 0; s < ends.ns; ++s) seen[static_cast<size_t>(s)] = Rgb(values.value[s]);
-      const double seen_average = Interpolant::average(receiver.corner_count, seen).x;
+      const double seen_average = Interpolant::average(weights, receiver.corner_count, seen).x;
       if (share >= 0.0 && seen_average > 0.0) scale = exact * share / seen_average;
     }
     for (int s = 0; s < ends.ns; ++s) values.value[s] *= scale;
@@ -289,29 +290,31 @@ bool finish(const LinkEvaluator& evaluator, Link& link, const LinkEnds& ends, Sa
   const auto conserve_start = Clock::now();
   for (int s = 0; s < ends.ns; ++s) values.value[s] = std::max(0.0, values.value[s]);
   const bool judges_correction = evaluator.oracle == Oracle::Noticeable;
+  const AverageWeights weights = hierarchy.average_weights(receiver);
   const double before =
-      judges_correction ? sample_average(receiver.corner_count, values.value) : 0.0;
+      judges_correction ? sample_average(weights, receiver.corner_count, values.value) : 0.0;
   const bool grid = !unoccluded && evaluator.visibility == VisibilityMode::Exact &&
                     hierarchy.samples_inset(receiver);
   const double shadow_contrast =
-      conserve_energy(receiver, ends, unoccluded, values, grid ? &candidates : nullptr);
+      conserve_energy(receiver, weights, ends, unoccluded, values, grid ? &candidates : nullptr);
   for (int s = 0; s < ends.ns; ++s)
     link.form_factor[static_cast<size_t>(s)] = static_cast<float>(values.value[s]);
   timings.form_factors += seconds_since(conserve_start);
 
   const auto oracle_start = Clock::now();
-  LinkSamples samples{std::span<const dvec3>(oracle_x, used),
-                      std::span<const double>(oracle_value, used),
-                      std::span<const dvec3>(oracle_grad, used),
-                      ends.n,
-                      receiver.area,
-                      hierarchy.diameter(receiver),
-                      resolvable_size(hierarchy.scene().total_area),
-                      used - with_tangents,
-                      judges_correction
-                          ? std::abs(sample_average(receiver.corner_count, values.value) - before)
-                          : 0.0,
-                      shadow_contrast};
+  LinkSamples samples{
+      std::span<const dvec3>(oracle_x, used),
+      std::span<const double>(oracle_value, used),
+      std::span<const dvec3>(oracle_grad, used),
+      ends.n,
+      receiver.area,
+      hierarchy.diameter(receiver),
+      resolvable_size(hierarchy.scene().total_area),
+      used - with_tangents,
+      judges_correction
+          ? std::abs(sample_average(weights, receiver.corner_count, values.value) - before)
+          : 0.0,
+      shadow_contrast};
   link.oracle = with_tangents >= 1 && used >= 2
                     ? static_cast<float>(oracle_geometry(evaluator.oracle, samples) /
                                          evaluator.geometric_scale)
