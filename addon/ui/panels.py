@@ -130,6 +130,14 @@ class RadiosityPanel:
     bl_context = "render"
 
 
+def split_layout(layout):
+    """`layout` with labels beside the values and no keyframe dots, as
+    Blender's own render settings are laid out."""
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+    return layout
+
+
 def result_selected(context):
     """Whether the user selected a generated result object (possible through the
     Outliner, or after making it selectable)."""
@@ -231,9 +239,7 @@ class RENDER_PT_radiosity_quality(RadiosityPanel, Panel):
 
     def draw(self, context):
         settings = context.scene.radiosity
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = split_layout(self.layout)
 
         col = draw_oracle_and_quality(layout, context, settings)
         col.prop(settings, "min_element_size")
@@ -278,9 +284,7 @@ class RENDER_PT_radiosity_output(RadiosityPanel, Panel):
 
     def draw(self, context):
         settings = context.scene.radiosity
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = split_layout(self.layout)
 
         col = layout.column()
         col.prop(settings, "output")

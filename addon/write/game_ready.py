@@ -51,14 +51,10 @@ UNLIT_TAG = "radiosity_unlit_material"
 
 def unlit_material():
     """The shared material that shows the "Radiosity" attribute unlit, one-sided."""
-    for mat in bpy.data.materials:
-        if mat.get(UNLIT_TAG):
-            return mat
-    mat = bpy.data.materials.new(UNLIT_MATERIAL_NAME)
-    mat[UNLIT_TAG] = True
-    mat.use_nodes = True
+    mat, made = bake.tagged_material(UNLIT_TAG, UNLIT_MATERIAL_NAME)
+    if not made:
+        return mat
     nodes, links = mat.node_tree.nodes, mat.node_tree.links
-    nodes.clear()
     colour = nodes.new("ShaderNodeVertexColor")
     colour.layer_name = bake.ATTRIBUTE
     colour.location = (-700, 0)

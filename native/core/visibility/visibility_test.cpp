@@ -224,8 +224,35 @@ TEST(VisiblePolygon, FormFactorAloneEqualsTheGradientPathsValue) {
   EXPECT_GT(hidden, 0);
 }
 
-// Central differences of the exact occluded F at steps h and h/2; a sample is
-// trusted only where the two agree (no discontinuity within the stencil).
+// Central differences of the exact occluded F at the receiver point, at steps h
+// and h/2, extrapolated (Richardson: the two differ by 3/4 of the coarse one's
+// h^2 error). `smooth` where they agree: no discontinuity within the stencil,
+// so a gradient can be checked against them there.
+struct FiniteDifference {
+  dvec3 gradient;
+  double scale;  // the gradient's size, at least 1e-3: what errors are relative to
+  bool smooth;
+};
+
+FiniteDifference finite_difference(const Configuration& c) {
+  const double h = 2e-5;  // about 1e-5 of the scene: truncation and rounding both below 1e-8
+  dvec3 fd(0.0), fd_half(0.0);
+  for (int k = 0; k < 3; ++k) {
+    dvec3 e(0.0);
+    e[k] = 1.0;
+    fd[k] = (visible_f(c.r + h * e, c.n, c.emitter, c.occluders) -
+             visible_f(c.r - h * e, c.n, c.emitter, c.occluders)) /
+            (2.0 * h);
+    fd_half[k] = (visible_f(c.r + 0.5 * h * e, c.n, c.emitter, c.occluders) -
+                  visible_f(c.r - 0.5 * h * e, c.n, c.emitter, c.occluders)) /
+                 h;
+  }
+  const dvec3 richardson = (4.0 * fd_half - fd) / 3.0;
+  const double scale = std::max(glm::length(richardson), 1e-3);
+  return {richardson, scale, glm::length(fd - fd_half) <= 1e-5 * scale};
+}
+
+// The gradient against finite_difference where it is smooth.
 TEST(VisiblePolygon, GradientMatchesFiniteDifferences) {
   std::mt19937_64 rng(11);
   int tested = 0, skipped = 0;
@@ -234,31 +261,17 @@ TEST(VisiblePolygon, GradientMatchesFiniteDifferences) {
     const Configuration c = random_configuration(rng, 2 + i % 4, 0.3);
     const FormFactorGradient fg = visible_form_factor_gradient(c.r, c.n, c.emitter, c.occluders);
     if (fg.value <= 0.0) continue;
-    const double h = 2e-5;  // about 1e-5 of the scene: truncation and rounding both below 1e-8
-    dvec3 fd(0.0), fd_half(0.0);
-    for (int k = 0; k < 3; ++k) {
-      dvec3 e(0.0);
-      e[k] = 1.0;
-      fd[k] = (visible_f(c.r + h * e, c.n, c.emitter, c.occluders) -
-               visible_f(c.r - h * e, c.n, c.emitter, c.occluders)) /
-              (2.0 * h);
-      fd_half[k] = (visible_f(c.r + 0.5 * h * e, c.n, c.emitter, c.occluders) -
-                    visible_f(c.r - 0.5 * h * e, c.n, c.emitter, c.occluders)) /
-                   h;
-    }
-    // Richardson: the two estimates differ by 3/4 of the h^2 error of the coarse one.
-    const dvec3 richardson = (4.0 * fd_half - fd) / 3.0;
-    const double scale = std::max(glm::length(richardson), 1e-3);
-    if (glm::length(fd - fd_half) > 1e-5 * scale) {
+    const FiniteDifference fd = finite_difference(c);
+    if (!fd.smooth) {
       ++skipped;
       continue;
     }
     ++tested;
-    const double error = glm::length(fg.gradient - richardson) / scale;
+    const double error = glm::length(fg.gradient - fd.gradient) / fd.scale;
     worst = std::max(worst, error);
     EXPECT_LT(error, 1e-5) << "configuration " << i << " gradient (" << fg.gradient.x << ", "
-                           << fg.gradient.y << ", " << fg.gradient.z << ") fd (" << richardson.x
-                           << ", " << richardson.y << ", " << richardson.z << ")";
+                           << fg.gradient.y << ", " << fg.gradient.z << ") fd (" << fd.gradient.x
+                           << ", " << fd.gradient.y << ", " << fd.gradient.z << ")";
   }
   std::printf("gradient vs finite differences: %d tested, %d skipped, worst relative error %.3g\n",
               tested, skipped, worst);
@@ -330,26 +343,13 @@ TEST(VisiblePolygon, GradientMatchesFiniteDifferencesWithTracesBoxesAndHorizon) 
       c.occluders.push_back(t);
     const FormFactorGradient fg = visible_form_factor_gradient(c.r, c.n, c.emitter, c.occluders);
     if (fg.value <= 0.0) continue;
-    const double h = 2e-5;  // about 1e-5 of the scene: truncation and rounding both below 1e-8
-    dvec3 fd(0.0), fd_half(0.0);
-    for (int k = 0; k < 3; ++k) {
-      dvec3 e(0.0);
-      e[k] = 1.0;
-      fd[k] = (visible_f(c.r + h * e, c.n, c.emitter, c.occluders) -
-               visible_f(c.r - h * e, c.n, c.emitter, c.occluders)) /
-              (2.0 * h);
-      fd_half[k] = (visible_f(c.r + 0.5 * h * e, c.n, c.emitter, c.occluders) -
-                    visible_f(c.r - 0.5 * h * e, c.n, c.emitter, c.occluders)) /
-                   h;
-    }
-    const dvec3 richardson = (4.0 * fd_half - fd) / 3.0;
-    const double scale = std::max(glm::length(richardson), 1e-3);
-    if (glm::length(fd - fd_half) > 1e-5 * scale) {
+    const FiniteDifference fd = finite_difference(c);
+    if (!fd.smooth) {
       ++skipped;
       continue;
     }
     ++tested;
-    const double error = glm::length(fg.gradient - richardson) / scale;
+    const double error = glm::length(fg.gradient - fd.gradient) / fd.scale;
     worst = std::max(worst, error);
     EXPECT_LT(error, 1e-5) << "configuration " << i;
   }
