@@ -28,7 +28,16 @@ int child_centres(const Hierarchy& hierarchy, const Element& e, dvec3* out) {
 
 EmitterShape emitter_shape(const Hierarchy& hierarchy, const Element& emitter,
                            std::span<const dvec3> receiver_polygon) {
-  if (!(luminance(hierarchy.reflectance(emitter)) > 0.0)) return kUniformShape;
+  // Each child sends in proportion to its area (a quarter, but for the
+  // children of a quad that is not a parallelogram, Hierarchy::subdivide) and
+  // to how well it sees the receiver.
+  double share[4];
+  EmitterShape by_area;
+  for (int c = 0; c < 4; ++c) {
+    share[c] = hierarchy.element(emitter.first_child + c).area / emitter.area;
+    by_area[static_cast<size_t>(c)] = static_cast<_Float16>(4.0 * share[c]);
+  }
+  if (!(luminance(hierarchy.reflectance(emitter)) > 0.0)) return by_area;
   dvec3 x[4];
   child_centres(hierarchy, emitter, x);
   const dvec3 normal = hierarchy.normal(emitter);
@@ -36,11 +45,12 @@ EmitterShape emitter_shape(const Hierarchy& hierarchy, const Element& emitter,
   double mean = 0.0;
   for (int c = 0; c < 4; ++c) {
     f[c] = form_factor(x[c], normal, receiver_polygon);
-    mean += area_share(hierarchy, emitter, c) * f[c];
+    mean += share[c] * f[c];
   }
-  if (!(mean > 0.0) || !std::isfinite(mean)) return kUniformShape;
+  if (!(mean > 0.0) || !std::isfinite(mean)) return by_area;
   EmitterShape shape;
-  for (int c = 0; c < 4; ++c) shape[static_cast<size_t>(c)] = static_cast<_Float16>(f[c] / mean);
+  for (int c = 0; c < 4; ++c)
+    shape[static_cast<size_t>(c)] = static_cast<_Float16>(4.0 * share[c] * f[c] / mean);
   return shape;
 }
 
@@ -51,9 +61,8 @@ Rgb sent_radiance(const Hierarchy& hierarchy, std::int32_t emitter,
   Rgb sum(0.0);
   double weight = 0.0;
   for (int c = 0; c < 4; ++c) {
-    // The weights' sum also renormalises half-precision rounding.
-    const double w =
-        static_cast<double>(shape[static_cast<size_t>(c)]) * area_share(hierarchy, e, c);
+    // The weights' sum renormalises half-precision rounding.
+    const double w = static_cast<double>(shape[static_cast<size_t>(c)]);
     sum += w * radiance[static_cast<size_t>(e.first_child + c)];
     weight += w;
   }

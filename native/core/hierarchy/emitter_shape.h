@@ -17,25 +17,22 @@
 
 namespace radiosity {
 
-// Per child of the emitter, its share of the link's form factor over the
-// child's share of the area (area_share; the shares' mean, so weighted, is one). Half precision:
-// the shape corrects a few per cent of a link's light, so 1e-3 of it is far below what matters.
+// Per child of the emitter, four times its share of the light the link
+// carries: its share of the emitter's area times its form factor to the
+// receiver over the emitter's (area-weighted) mean; all ones for four equal
+// children that see the receiver alike. Half precision: 1e-3 of a child's
+// share is far below what matters, and sending and its bookkeeping
+// (energy_balance.cpp) read the same rounded numbers.
 using EmitterShape = std::array<_Float16, 4>;
-inline constexpr EmitterShape kUniformShape{1, 1, 1, 1};
 inline constexpr EmitterShape kShapeNotComputed{-1, -1, -1, -1};
 inline bool shape_computed(const EmitterShape& shape) { return shape[0] >= 0; }
 
 // The shape of the unoccluded form factor from the emitter's children to the
-// receiver polygon (kUniformShape where it is zero everywhere, or where the
-// emitter reflects nothing: its radiance is then uniform).
+// receiver polygon (the children's area shares alone where it is zero
+// everywhere, or where the emitter reflects nothing: its radiance is then
+// uniform).
 EmitterShape emitter_shape(const Hierarchy& hierarchy, const Element& emitter,
                            std::span<const dvec3> receiver_polygon);
-
-// Child c's share of a split element's area: a quarter, but for the children
-// of a quad that is not a parallelogram (Hierarchy::subdivide).
-inline double area_share(const Hierarchy& hierarchy, const Element& parent, int c) {
-  return hierarchy.element(parent.first_child + c).area / parent.area;
-}
 
 // What `emitter` sends along a link of this shape: its radiance if it is a
 // leaf, else its children's radiances in the shape's shares (its own radiance

@@ -323,7 +323,7 @@ std::int32_t Hierarchy::subdivide(std::int32_t index) {
                                            vertices_[corner[3]] - vertices_[corner[1]]))
             : parent.area / 4;
     Element child;
-    child.corner = children[static_cast<size_t>(k)];
+    child.corner = corner;
     child.parent = index;
     child.patch = parent.patch;
     child.side = parent.side;

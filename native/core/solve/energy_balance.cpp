@@ -106,10 +106,8 @@ std::vector<double> delivered_fractions(const Hierarchy& h, const std::vector<Li
       delivered[static_cast<size_t>(l.emitter)] += power / q.area;
       continue;
     }
-    // What each child sends is its shape times its area share (sent_radiance).
     double weights = 0.0;
-    for (int c = 0; c < 4; ++c)
-      weights += static_cast<double>(l.emitter_shape[static_cast<size_t>(c)]) * area_share(h, q, c);
+    for (_Float16 w : l.emitter_shape) weights += static_cast<double>(w);
     if (!(weights > 0.0)) {
       delivered[static_cast<size_t>(l.emitter)] += power / q.area;
       continue;
@@ -117,7 +115,8 @@ std::vector<double> delivered_fractions(const Hierarchy& h, const std::vector<Li
     for (int c = 0; c < 4; ++c) {
       const std::int32_t child = q.first_child + c;
       delivered[static_cast<size_t>(child)] +=
-          power * static_cast<double>(l.emitter_shape[static_cast<size_t>(c)]) / weights / q.area;
+          power * static_cast<double>(l.emitter_shape[static_cast<size_t>(c)]) / weights /
+          h.element(child).area;
     }
   }
   if (!far.empty()) {
