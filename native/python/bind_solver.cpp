@@ -252,6 +252,7 @@ py::dict stats_dict(const SolveStats& s) {
   d["seconds_clustering"] = s.seconds_clustering;
   d["seconds_ray_pass"] = s.seconds_ray_pass;
   d["ray_pass_rays"] = s.ray_pass_rays;
+  d["unlit_sides"] = s.unlit_sides;
   d["seconds_gather"] = s.seconds_gather;
   d["cpu_visibility"] = s.link_cpu.visibility;
   d["cpu_form_factors"] = s.link_cpu.form_factors;

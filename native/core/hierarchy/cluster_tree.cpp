@@ -32,11 +32,13 @@ glm::dmat3 ClusterNode::covariance_matrix() const {
   return glm::dmat3(c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5]);
 }
 
-ClusterTree::ClusterTree(const Hierarchy& hierarchy) {
+ClusterTree::ClusterTree(const Hierarchy& hierarchy, std::span<const std::uint8_t> left_out) {
   for (std::uint32_t p = 0; p < hierarchy.scene().patches.size(); ++p) {
     for (int side = 0; side < 2; ++side) {
       const std::int32_t root = hierarchy.root(p, side);
-      if (root == kNone) continue;
+      if (root == kNone ||
+          (!left_out.empty() && left_out[static_cast<std::size_t>(root)] != 0))
+        continue;
       const Element& e = hierarchy.element(root);
       if (luminance(hierarchy.reflectance(e)) > 0.0 || luminance(hierarchy.emission(e)) > 0.0)
         sides_.push_back(root);

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/hierarchy/hierarchy.h"
@@ -43,8 +44,9 @@ struct ClusterNode {
 
 class ClusterTree {
  public:
-  // Over every top-level element that reflects or emits.
-  explicit ClusterTree(const Hierarchy& hierarchy);
+  // Over every top-level element that reflects or emits, but those marked in
+  // `left_out` (per element, or empty: none).
+  explicit ClusterTree(const Hierarchy& hierarchy, std::span<const std::uint8_t> left_out = {});
   ClusterTree() = default;
 
   const std::vector<ClusterNode>& nodes() const { return nodes_; }

@@ -41,6 +41,15 @@ struct RayPass {
   // the back of a one-sided face): 0 where the surroundings close around it
   // (energy_balance.h).
   std::vector<float> escaped;
+  // Per top-level element: 1 where the side reflects and no light reaches it
+  // by the pass's rays (the inside of a closed object with nothing lit in
+  // it, the outside of a closed room under no sky). Light starts at the
+  // emitting sides and the sides an emitter, a light or the sky lit directly,
+  // and goes from a side to every side whose rays met it. Such sides are left
+  // out of linking: their links would carry nothing
+  // (Solver::drop_links_light_cannot_reach drops them after linking), yet
+  // the insides of a dense closed mesh face each other at every distance.
+  std::vector<std::uint8_t> unlit;
   int rays = 0;        // per reflecting top-level element
   int iterations = 0;  // Jacobi iterations
   bool complete = false;

@@ -286,7 +286,12 @@ void Solver::look_by_rays() {
     shown.iterations = pass.iterations;
     result_.stats = shown;
   }
-  if (pass.complete) balance_.set_escaped(std::move(pass.escaped));
+  if (pass.complete) {
+    balance_.set_escaped(std::move(pass.escaped));
+    // Sides no light reaches take no part in linking (RayPass::unlit).
+    stats_.unlit_sides = static_cast<std::size_t>(std::count(pass.unlit.begin(), pass.unlit.end(), 1));
+    if (stats_.unlit_sides) clusters_ = ClusterTree(hierarchy_, pass.unlit);
+  }
   stats_.seconds_ray_pass = seconds_since(start);
   if (pass.complete) report(SolvePhase::Linking, 0.0, &result_);  // shown while linking runs
 }

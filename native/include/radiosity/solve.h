@@ -212,6 +212,7 @@ struct SolveStats {
   double seconds_clustering = 0.0;  // of linking: the walk over cluster pairs, with its rays
   double seconds_ray_pass = 0.0;    // the rough look before linking (ray_pass.h)
   int ray_pass_rays = 0;            // its rays per reflecting top-level element
+  std::size_t unlit_sides = 0;      // top-level sides it found no light reaches: not linked
   LinkTimings link_cpu;             // CPU seconds over all threads
   double seconds_gather = 0.0;      // gather and push/pull, wall clock
   std::size_t element_bytes = 0;
