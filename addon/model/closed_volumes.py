@@ -24,8 +24,8 @@ INSIDE_WINDING = 0.75
 MIN_RELATIVE_VOLUME = 1e-9
 # Points this close to the surface, as a share of the object's size, lie on it.
 ON_SURFACE = 1e-7
-# Point-triangle pairs one object's test may cost; beyond, it keeps both sides.
-MAX_PAIRS = 200_000_000
+# Point-triangle pairs one object's test may cost (a few seconds); beyond, it keeps both sides.
+MAX_PAIRS = 50_000_000
 
 
 def _polygon_edges(face_vertices, face_sizes):
@@ -62,7 +62,7 @@ def winding_numbers(points, corners):
     about each of `points` (P, 3): its solid angle over 4 pi (Van Oosterom and
     Strackee's formula for a triangle's solid angle)."""
     out = np.zeros(len(points))
-    chunk = max(1, 4_000_000 // max(len(corners), 1))
+    chunk = max(1, 500_000 // max(len(corners), 1))  # points per pass: about 100 MB of temporaries
     for begin in range(0, len(points), chunk):
         p = points[begin:begin + chunk, None, None, :]
         v = corners[None, :, :, :] - p                      # (p, T, 3, 3)
@@ -85,7 +85,7 @@ def on_surface(points, corners, tolerance):
     area2 = np.linalg.norm(normal, axis=1)
     ok = area2 > 0
     a, e1, e2, normal, area2 = a[ok], e1[ok], e2[ok], normal[ok] / area2[ok, None], area2[ok]
-    chunk = max(1, 4_000_000 // max(len(a), 1))
+    chunk = max(1, 500_000 // max(len(a), 1))
     for begin in range(0, len(points), chunk):
         d = points[begin:begin + chunk, None, :] - a[None]                      # (p, T, 3)
         height = np.einsum("ptk,tk->pt", d, normal)
