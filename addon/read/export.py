@@ -32,7 +32,7 @@ import bpy
 import numpy as np
 
 from .. import compat
-from ..model import arrays, light_units, surface_uv
+from ..model import arrays, closed_volumes, light_units, surface_uv
 from ..write.result_state import HIDDEN_TAG, RESULT_TAG
 from . import render_visibility
 
@@ -429,7 +429,14 @@ def export_scene(context, blender_version=None):
     world, world_note = world_radiance(context.scene.world)
     if world_note:
         unmodelled.append(world_note)
-    return ExportedScene(arrays=builder.arrays(), parts=parts, unmodelled=unmodelled,
+    scene_arrays = builder.arrays()
+    # Closed objects with nothing inside them (no light, no other object, not
+    # the camera): their inside sides see only each other, in the dark.
+    inside_points = [light["position"] for light in direct_lights if "position" in light]
+    if context.scene.camera is not None:
+        inside_points.append(np.array(context.scene.camera.matrix_world.translation, dtype=float))
+    scene_arrays["two_sided"] &= ~closed_volumes.empty_closed_faces(scene_arrays, inside_points)
+    return ExportedScene(arrays=scene_arrays, parts=parts, unmodelled=unmodelled,
                          hidden_sources=sorted(hidden_sources), lights=direct_lights, world=world,
                          repaired=repaired)
 
