@@ -36,8 +36,7 @@ ClusterTree::ClusterTree(const Hierarchy& hierarchy, std::span<const std::uint8_
   for (std::uint32_t p = 0; p < hierarchy.scene().patches.size(); ++p) {
     for (int side = 0; side < 2; ++side) {
       const std::int32_t root = hierarchy.root(p, side);
-      if (root == kNone ||
-          (!left_out.empty() && left_out[static_cast<std::size_t>(root)] != 0))
+      if (root == kNone || (!left_out.empty() && left_out[static_cast<std::size_t>(root)] != 0))
         continue;
       const Element& e = hierarchy.element(root);
       if (luminance(hierarchy.reflectance(e)) > 0.0 || luminance(hierarchy.emission(e)) > 0.0)

@@ -168,8 +168,7 @@ std::vector<std::uint8_t> sides_no_light_reaches(const Hierarchy& hierarchy,
   std::vector<std::int32_t> queue;
   for (std::int32_t id : root_element) {
     const auto i = static_cast<std::size_t>(id);
-    if (luminance(hierarchy.emission(hierarchy.element(id))) > 0.0 ||
-        bringing[i] >= enough) {
+    if (luminance(hierarchy.emission(hierarchy.element(id))) > 0.0 || bringing[i] >= enough) {
       reached[i] = 1;
       queue.push_back(id);
     }

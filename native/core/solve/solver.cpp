@@ -289,7 +289,8 @@ void Solver::look_by_rays() {
   if (pass.complete) {
     balance_.set_escaped(std::move(pass.escaped));
     // Sides no light reaches take no part in linking (RayPass::unlit).
-    stats_.unlit_sides = static_cast<std::size_t>(std::count(pass.unlit.begin(), pass.unlit.end(), 1));
+    stats_.unlit_sides =
+        static_cast<std::size_t>(std::count(pass.unlit.begin(), pass.unlit.end(), 1));
     if (stats_.unlit_sides) clusters_ = ClusterTree(hierarchy_, pass.unlit);
   }
   stats_.seconds_ray_pass = seconds_since(start);
