@@ -21,7 +21,7 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import _radiosity as rad  # noqa: E402
-from synthetic_scenes import room_with_blocker  # noqa: E402
+from synthetic_scenes import SceneBuilder, add_box, native_scene, room_with_blocker  # noqa: E402
 from test_solver import ORACLES, polygon_areas, reflected_power  # noqa: E402
 
 QUALITY = 0.6
@@ -69,6 +69,33 @@ class RelightTest(unittest.TestCase):
                 np.testing.assert_array_equal(relit.face_vertices, fresh.face_vertices)
                 scale = float(np.max(fresh.radiance))
                 np.testing.assert_allclose(relit.radiance, fresh.radiance, rtol=0, atol=1e-5 * scale)
+                np.testing.assert_allclose(relit.radiance, 2.0 * first.radiance, rtol=0, atol=1e-5 * scale)
+
+    def test_a_solve_whose_cluster_links_were_all_refined_relights_exactly(self):
+        # A 2 m room with a box on its floor: the first pass links the box's
+        # sides and the far walls as clusters, refinement replaces every one
+        # of them with links between faces. The light the cluster links
+        # gathered before must go with them: left over, it was counted beside
+        # the face links' (0.15 % of the cube scene's light), and a relight
+        # kept it at the old brightness (2.7e-4 of the brightest off).
+        def box_room(emission):
+            b = SceneBuilder()
+            add_box(b, (0, 0, 0), (2, 2, 2), reflectance=0.7, inward=True)
+            b.polygon([(0.75, 0.75, 1.99), (0.75, 1.25, 1.99), (1.25, 1.25, 1.99), (1.25, 0.75, 1.99)], 0.0,
+                      emission=emission, two_sided=False)
+            add_box(b, (0.6, 0.6, 0), (1.1, 1.1, 0.5), reflectance=0.7)
+            return native_scene(rad, b.arrays())
+
+        for oracle in ("standard", "noticeable"):
+            with self.subTest(oracle=oracle):
+                coarse = rad.solve(box_room(10.0), oracle=oracle, quality=0.2)
+                self.assertGreater(coarse.stats["cluster_links"], 0)
+                reuse = rad.SolveReuse()
+                first = rad.solve(box_room(10.0), oracle=oracle, quality=0.5, reuse=reuse)
+                self.assertEqual(first.stats["cluster_links"], 0)
+                relit = rad.solve(box_room(20.0), oracle=oracle, quality=0.5, reuse=reuse)
+                self.assertTrue(relit.stats["reused"], relit.stats["reuse_refusal"])
+                scale = float(np.max(relit.radiance))
                 np.testing.assert_allclose(relit.radiance, 2.0 * first.radiance, rtol=0, atol=1e-5 * scale)
 
     def test_a_new_wall_colour_gives_the_light_of_a_solve_from_nothing(self):

@@ -551,7 +551,12 @@ void Solver::group_links() {
 }
 
 void Solver::gather_far_light() {
-  if (cluster_links_.empty()) return;
+  if (cluster_links_.empty()) {
+    // Refinement may replace the last cluster link with element links: what
+    // the cluster links gathered before must not be added to theirs.
+    far_light_ = {};
+    return;
+  }
   cluster_gather_(clusters_, cluster_links_, hierarchy_, source_, far_light_);
 }
 
