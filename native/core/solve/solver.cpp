@@ -275,9 +275,11 @@ void Solver::look_by_rays() {
   if (pass.complete) {
     std::vector<SampleRgb> leaf(hierarchy_.elements().size());
     std::vector<Element>& elements = hierarchy_.elements();
+    // Shown as the solve will show them: the sides light reaches, without
+    // those its stray rays alone reach (RayPass::unlit).
     for (size_t e = 0; e < pass.gathered.size(); ++e) {
       leaf[e].fill(pass.gathered[e]);
-      elements[e].has_links = luminance(pass.gathered[e]) > 0.0 ? 1 : 0;
+      elements[e].has_links = luminance(pass.gathered[e]) > 0.0 && !pass.unlit[e] ? 1 : 0;
     }
     result_.mesh = make_output_mesh(hierarchy_, leaf);
     for (size_t e = 0; e < pass.gathered.size(); ++e) elements[e].has_links = 0;
