@@ -20,6 +20,10 @@
 6. A solve in a window against a headless one (bench/window_speed.py, in
    Blender under xvfb-run): what Esc keeps and what each has refined after
    2, 4 and 6 s; <build>/bench/window_speed.md. Quick mode: one round.
+7. Scale (bench/scale_curve.py): time, links and memory against faces for
+   many small objects and a few dense ones, 1,000 to 100,000 faces (quick:
+   to 10,000); <build>/bench/scale_curve.{csv,md,png}. Larger points by hand
+   (--faces ... 300000 1000000: minutes each, gigabytes).
 """
 
 import argparse
@@ -64,6 +68,9 @@ def main():
     subprocess.run([args.blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
                     str(ROOT / "bench" / "window_speed.py"), "--", "--build", args.build]
                    + (["--quick"] if args.quick else []), check=True)
+    print("== scale", flush=True)
+    subprocess.run([sys.executable, str(ROOT / "bench" / "scale_curve.py"), "--build", args.build]
+                   + (["--faces", "1000", "3000", "10000"] if args.quick else []), check=True)
 
 
 if __name__ == "__main__":
