@@ -278,10 +278,11 @@ bool clip_space(Workspace& w, const dvec3& m, const dvec3& o, std::int32_t bound
   return w.space_a.size() >= 3;
 }
 
-// Projects an occluder (a planar convex polygon: a triangle, or two coplanar
-// triangles merged into a quad) from r onto the emitter plane, clipped to the
-// pyramid from r through the (horizon-clipped) emitter, into w.occluder
-// (convex, counter-clockwise). Returns false if nothing of positive area remains.
+// Projects an occluder (a convex polygon: a triangle, two coplanar triangles
+// merged into a quad, or two folded ones where project_fold allows) from r
+// onto the emitter plane, clipped to the pyramid from r through the
+// (horizon-clipped) emitter, into w.occluder (convex, counter-clockwise).
+// Returns false if nothing of positive area remains.
 bool project_occluder(std::span<const dvec3> poly, Workspace& w) {
   const EmitterFrame& f = w.frame;
   const double tol = w.tol.space;
@@ -536,9 +537,16 @@ bool setup(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter, Works
   return true;
 }
 
-// Triangles a and b share an edge (the same two vertices) and together form a
-// planar, strictly convex quad: writes it (in a's orientation) to `quad`.
-bool merge_into_quad(const Triangle& a, const Triangle& b, double tol, dvec3 quad[4]) {
+// How two consecutive occluder triangles join: not at all, as a planar
+// strictly convex quad (one occluder wherever it is seen from), or folded
+// along a shared edge (a non-planar mesh quad split in two, as the add-on
+// splits a subdivided mesh's faces): one occluder only where its projection
+// is convex (project_fold).
+enum class Join : std::uint8_t { None, Planar, Folded };
+
+// Whether triangles a and b share an edge (the same two vertices), and if so
+// the quad around both (in a's orientation) in `quad`.
+Join join_triangles(const Triangle& a, const Triangle& b, double tol, dvec3 quad[4]) {
   for (int e = 0; e < 3; ++e) {
     const dvec3& p = a.v[e];
     const dvec3& q = a.v[(e + 1) % 3];
@@ -555,15 +563,57 @@ bool merge_into_quad(const Triangle& a, const Triangle& b, double tol, dvec3 qua
     quad[0] = p, quad[1] = x, quad[2] = q, quad[3] = other;
     const dvec3 n = glm::cross(q - p, other - p);
     const double n_len = glm::length(n);
-    if (!(n_len > 0.0) || std::abs(glm::dot(n / n_len, x - p)) > tol) return false;
+    if (!(n_len > 0.0)) return Join::None;
+    if (std::abs(glm::dot(n / n_len, x - p)) > tol) return Join::Folded;
     for (int i = 0; i < 4; ++i) {
       const dvec3 turn =
           glm::cross(quad[(i + 1) % 4] - quad[i], quad[(i + 2) % 4] - quad[(i + 1) % 4]);
-      if (!(glm::dot(turn, n) > 1e-12 * n_len * n_len)) return false;
+      if (!(glm::dot(turn, n) > 1e-12 * n_len * n_len)) return Join::None;
     }
-    return true;
+    return Join::Planar;
   }
-  return false;
+  return Join::None;
+}
+
+// The folded quad of triangles a and b (join_triangles) projected as one
+// occluder, where that is exact: seen from r, the two triangles project to
+// two triangles sharing the image of their common edge, and where both lie
+// wholly in front of the emitter plane (no trace to clip along, which a
+// non-planar quad has no single line for) and r sees the same face of both
+// (the images do not overlap), their union is the image of the quad; the
+// side planes through r clip the quad as they clip its image. Used only
+// when that image is convex, as subtract_occluder needs; false otherwise,
+// with nothing left in the workspace (the triangles are then taken one by one).
+bool project_fold(const dvec3 quad[4], Workspace& w) {
+  const double tol = w.tol.space;
+  // Wholly between r and the emitter plane: in front of r, so that its image
+  // is the union of the triangles' images.
+  for (int i = 0; i < 4; ++i) {
+    const double h = w.frame.height(quad[i]);
+    if (!(h > tol && h < w.height_r - tol)) return false;
+  }
+  // The two triangles as the quad's fan from its first corner (the shared edge
+  // is quad[0] to quad[2]): oriented alike, whatever the mesh's orientation.
+  const auto side = [&](const dvec3& p, const dvec3& q, const dvec3& t) {
+    const dvec3 n = glm::cross(q - p, t - p);
+    const double n_len = glm::length(n);
+    return n_len > 0.0 ? glm::dot(n / n_len, w.r - p) : 0.0;
+  };
+  const double side_a = side(quad[0], quad[1], quad[2]), side_b = side(quad[0], quad[2], quad[3]);
+  if (!((side_a > tol && side_b > tol) || (side_a < -tol && side_b < -tol))) return false;
+  const std::size_t lines = w.lines.size(), anchors = w.anchors.size();
+  bool convex = project_occluder(std::span<const dvec3>(quad, 4), w);
+  const std::size_t m = w.occluder.size();
+  for (std::size_t i = 0; convex && i < m; ++i) {
+    const dvec2 u = w.occluder[(i + 1) % m].p - w.occluder[i].p;
+    const dvec2 v = w.occluder[(i + 2) % m].p - w.occluder[(i + 1) % m].p;
+    convex = u.x * v.y - u.y * v.x >= -w.tol.area;
+  }
+  if (!convex) {
+    w.lines.resize(lines);
+    w.anchors.resize(anchors);
+  }
+  return convex;
 }
 
 // Runs the whole method; the visible pieces are left in w.pieces / w.start.
@@ -583,15 +633,25 @@ bool compute_visible_pieces(const dvec3& r, const dvec3& n, std::span<const dvec
   dvec3 quad[4];
   for (std::size_t i = 0; i < occluders.size(); ++i) {
     const std::size_t lines = w.lines.size(), anchors = w.anchors.size();
-    // Two consecutive triangles that make a planar convex quad (a mesh quad split
-    // in two) are one occluder: no cut along their shared diagonal.
+    // Two consecutive triangles that make one convex quad (a mesh quad split in
+    // two) are one occluder: no cut along their shared diagonal, and half the
+    // subtractions.
     std::span<const dvec3> poly(occluders[i].v);
-    if (i + 1 < occluders.size() &&
-        merge_into_quad(occluders[i], occluders[i + 1], w.tol.space, quad)) {
-      poly = std::span<const dvec3>(quad, 4);
+    const Join join = i + 1 < occluders.size()
+                          ? join_triangles(occluders[i], occluders[i + 1], w.tol.space, quad)
+                          : Join::None;
+    bool projected = false;
+    if (join == Join::Folded && project_fold(quad, w)) {
+      projected = true;
       ++i;
+    } else {
+      if (join == Join::Planar) {
+        poly = std::span<const dvec3>(quad, 4);
+        ++i;
+      }
+      projected = project_occluder(poly, w);
     }
-    if (!project_occluder(poly, w)) {
+    if (!projected) {
       // Nothing of it is in the way: forget its lines.
       w.lines.resize(lines);
       w.anchors.resize(anchors);
