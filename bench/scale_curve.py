@@ -82,6 +82,7 @@ def plot(rows, path):
     panels = (("seconds", "seconds (wall)"), ("links_per_face", "links per face (element + cluster)"),
               ("solve_bytes_per_face", "resident bytes the solve adds, per face"))
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
+    axes[1].set_ylim(10, 200)
     for ax, (key, label) in zip(axes, panels):
         for family, name in FAMILIES.items():
             points = sorted((r["faces"], r[key]) for r in rows if r["family"] == family)
@@ -92,6 +93,10 @@ def plot(rows, path):
         ax.set_xlabel("input faces")
         ax.set_ylabel(label)
         ax.grid(True, which="both", alpha=0.3)
+    # Issue 32's targets: 100,000 faces in 60 s, a million in 15 minutes; 20 links per face.
+    axes[0].plot([1e5, 1e6], [60, 900], "k*", markersize=10, label="issue 32's targets")
+    axes[1].axhline(20, color="k", linestyle="--", label="issue 32's target")
+    axes[1].legend()
     axes[0].legend()
     fig.suptitle("Scale: quality 0, sampled visibility, standard oracle (bench/scale_curve.py)")
     fig.tight_layout()
