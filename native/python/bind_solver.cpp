@@ -253,6 +253,7 @@ py::dict stats_dict(const SolveStats& s) {
   d["seconds_ray_pass"] = s.seconds_ray_pass;
   d["ray_pass_rays"] = s.ray_pass_rays;
   d["unlit_sides"] = s.unlit_sides;
+  d["dim_sides"] = s.dim_sides;
   d["seconds_gather"] = s.seconds_gather;
   d["cpu_visibility"] = s.link_cpu.visibility;
   d["cpu_form_factors"] = s.link_cpu.form_factors;
@@ -358,7 +359,8 @@ SolveOptions read_options(const std::string& oracle, double quality, const py::o
                           const py::object& rays, const py::object& bounces,
                           const py::object& threads, double min_element_area,
                           const std::string& leaf_links, std::optional<double> cluster_separation,
-                          const py::object& memory_limit, bool yield_to_interface) {
+                          double dim_share, const py::object& memory_limit,
+                          bool yield_to_interface) {
   SolveOptions options;
   options.oracle = read_oracle(oracle);
   options.quality = quality;
@@ -386,6 +388,9 @@ SolveOptions read_options(const std::string& oracle, double quality, const py::o
           "cluster_separation must be greater than 1 (or inf: no cluster links)");
     options.cluster_separation = *cluster_separation;
   }
+  if (!(dim_share >= 0.0 && dim_share <= 1.0))
+    throw std::invalid_argument("dim_share must lie in [0, 1] (0: every lit side is linked)");
+  options.dim_share = dim_share;
   const auto links = parse_leaf_links(leaf_links);
   if (!links)
     throw std::invalid_argument("leaf_links must be 'none', 'near' or 'all', got '" + leaf_links +
@@ -480,12 +485,13 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
                   const std::string& visibility, const py::object& rays, const py::object& bounces,
                   const py::object& threads, const py::object& progress, const py::object& cancel,
                   double min_element_area, const std::string& leaf_links,
-                  std::optional<double> cluster_separation, const py::object& memory_limit,
-                  bool pass_results, bool yield_to_interface, const py::object& reuse,
-                  const py::object& clock) {
-  SolveOptions options = read_options(oracle, quality, max_elements, time_budget, visibility, rays,
-                                      bounces, threads, min_element_area, leaf_links,
-                                      cluster_separation, memory_limit, yield_to_interface);
+                  std::optional<double> cluster_separation, double dim_share,
+                  const py::object& memory_limit, bool pass_results, bool yield_to_interface,
+                  const py::object& reuse, const py::object& clock) {
+  SolveOptions options =
+      read_options(oracle, quality, max_elements, time_budget, visibility, rays, bounces, threads,
+                   min_element_area, leaf_links, cluster_separation, dim_share, memory_limit,
+                   yield_to_interface);
   PyReuse* kept = nullptr;
   if (!reuse.is_none()) {
     if (!py::isinstance<PyReuse>(reuse))
@@ -688,7 +694,9 @@ void bind_solver(py::module_& m) {
       "leaf_links: 'near' | 'all' | 'none', which links follow a split end down ('all': energy "
       "to 1e-3);\n"
       "cluster_separation: clusters of faces this many times their radii apart share one link\n"
-      "(default from quality, 2 to 10; inf: none); memory_limit: bytes the elements and links "
+      "(default from quality, 2 to 10; inf: none); dim_share: sides no ray brought direct light\n"
+      "whose first-look light is below this share of the mean gather by rays, not links (0: "
+      "none);\nmemory_limit: bytes the elements and links "
       "may hold\n"
       "(default 3/4 of the available memory): refinement stops there (stats['stopped_by'] == "
       "'memory'),\n"
@@ -709,9 +717,10 @@ void bind_solver(py::module_& m) {
         py::arg("threads") = py::none(), py::arg("progress") = py::none(),
         py::arg("cancel") = py::none(), py::arg("min_element_area") = defaults.min_element_area,
         py::arg("leaf_links") = std::string(leaf_links_name(defaults.leaf_links)),
-        py::arg("cluster_separation") = py::none(), py::arg("memory_limit") = py::none(),
-        py::arg("pass_results") = false, py::arg("yield_to_interface") = false,
-        py::arg("reuse") = py::none(), py::arg("clock") = py::none(), solve_doc.c_str());
+        py::arg("cluster_separation") = py::none(), py::arg("dim_share") = defaults.dim_share,
+        py::arg("memory_limit") = py::none(), py::arg("pass_results") = false,
+        py::arg("yield_to_interface") = false, py::arg("reuse") = py::none(),
+        py::arg("clock") = py::none(), solve_doc.c_str());
 
   m.def(
       "quality_threshold",

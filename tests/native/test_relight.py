@@ -114,6 +114,19 @@ class RelightTest(unittest.TestCase):
                 np.testing.assert_allclose(lit, expected, rtol=0.02)
                 self.assertAlmostEqual(reflected_power(relit) / reflected_power(fresh), 1.0, delta=0.005)
 
+    def test_a_white_light_turned_red_relights_every_colour(self):
+        # The relight starts from the old solution scaled to the new light's
+        # luminance, so the luminance hardly changes while every colour does:
+        # convergence measured on luminance alone stopped after three
+        # iterations with the room's green a third of its red, not a fifth.
+        reuse = rad.SolveReuse()
+        for colour in ((5.0, 5.0, 5.0), (5.0, 1.0, 1.0)):
+            result = rad.solve(native_scene(rad, room_with_blocker(light=colour)[0].arrays()), oracle="standard",
+                               quality=QUALITY, reuse=reuse)
+        self.assertTrue(result.stats["reused"], result.stats["reuse_refusal"])
+        lit = result.radiance[:, 0] > 1e-3 * float(np.max(result.radiance[:, 0]))
+        np.testing.assert_allclose(result.radiance[lit, 1] / result.radiance[lit, 0], 0.2, rtol=1e-3)
+
     def test_light_colours_relight_and_a_light_turned_on_does_not(self):
         lamp = {"type": "point", "position": (1.0, 1.0, 2.0), "intensity": (3.0, 3.0, 3.0)}
         warm = dict(lamp, intensity=(4.0, 2.5, 1.0))

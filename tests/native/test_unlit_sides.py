@@ -31,12 +31,13 @@ ROOM_OUTSIDE = 10
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 
 
-def room_with_ball(two_sided=True, opening=0, light_inside=False, sky=0.0):
+def room_with_ball(two_sided=True, opening=0, light_inside=False, sky=0.0, lamp=5.0):
     """room_with_blocker's lit room with a lumpy icosphere (320 triangles,
     radius 0.5, dents that face each other) floating beside the plate; its
     `opening` triangles nearest the ceiling light left out; with
-    `light_inside`, a point light at its centre; under a uniform `sky`."""
-    b, parts = room_with_blocker()
+    `light_inside`, a point light at its centre; under a uniform `sky`; the
+    ceiling light's emission `lamp` (a number or a colour)."""
+    b, parts = room_with_blocker(light=lamp)
     v, f = _icosphere(2)
     ripple = 1 + 0.3 * np.sin(5 * v[:, 0]) * np.sin(5 * v[:, 1]) * np.sin(5 * v[:, 2] + 1)
     centre = np.array([1.0, 1.0, 1.2])

@@ -81,6 +81,7 @@ struct PushPull {
   const LinkGather& gather;
   const std::vector<SampleScale>& down_scale;
   const std::vector<SampleRgb>& direct;
+  const std::vector<Rgb>& by_rays;
   std::vector<SampleRgb>* leaf_out;
 
   Rgb operator()(std::int32_t index, const SampleRgb& down, Change& change) const;
@@ -95,10 +96,15 @@ Rgb PushPull::operator()(std::int32_t index, const SampleRgb& down, Change& chan
         scaled ? static_cast<double>(down_scale[static_cast<size_t>(index)][s]) * down[s] : down[s];
   if (static_cast<size_t>(index) < direct.size())
     for (size_t s = 0; s < kMaxSamples; ++s) total[s] += direct[static_cast<size_t>(index)][s];
+  if (static_cast<size_t>(index) < by_rays.size())
+    for (size_t s = 0; s < kMaxSamples; ++s) total[s] += by_rays[static_cast<size_t>(index)];
   Rgb radiance;
   if (e.is_leaf()) {
     radiance = h.emission(e) + h.reflectance(e) * glm::max(h.average(e, total), Rgb(0.0));
-    change.delta += std::abs(luminance(radiance) - luminance(e.radiance)) * e.area;
+    // Each channel's change, weighted as luminance weighs it: a light turned
+    // from white to red at the same luminance (a relight starts from the old
+    // solution so scaled) changes every colour but hardly the luminance.
+    change.delta += luminance(glm::abs(radiance - e.radiance)) * e.area;
     change.total += luminance(radiance) * e.area;
     if (leaf_out) (*leaf_out)[static_cast<size_t>(index)] = total;
   } else {
@@ -130,9 +136,9 @@ std::vector<SampleRgb> gathered_at_leaves(const Hierarchy& h, const LinkGather& 
 
 double push_pull(Hierarchy& h, const LinkGather& gather, const std::vector<SampleRgb>& far_light,
                  const std::vector<SampleScale>& down_scale, const std::vector<SampleRgb>& direct,
-                 std::vector<SampleRgb>* leaf_out) {
+                 const std::vector<Rgb>& by_rays, std::vector<SampleRgb>* leaf_out) {
   std::vector<Change> changes(h.root_count());
-  const PushPull visit{h, gather, down_scale, direct, leaf_out};
+  const PushPull visit{h, gather, down_scale, direct, by_rays, leaf_out};
   for_each_root(
       h, [&](size_t r, std::int32_t root) { visit(root, far_down(far_light, root), changes[r]); });
   Change sum;

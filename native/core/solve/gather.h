@@ -50,11 +50,13 @@ std::vector<SampleRgb> gathered_at_leaves(const Hierarchy& hierarchy, const Link
 // what each leaf sample receives from its ancestors (energy_balance.h).
 // `direct` (per element, may be empty) is what each element gathers from the
 // lights that are not surfaces (direct_light.h), at its samples.
+// `by_rays` (per top-level element, may be empty) is what it gathers by rays,
+// uniform over it (dim_sides.h).
 // `leaf_out`, if given, receives what each leaf gathered at its samples (for
 // the output mesh).
 double push_pull(Hierarchy& hierarchy, const LinkGather& gather,
                  const std::vector<SampleRgb>& far_light,
                  const std::vector<SampleScale>& down_scale, const std::vector<SampleRgb>& direct,
-                 std::vector<SampleRgb>* leaf_out = nullptr);
+                 const std::vector<Rgb>& by_rays, std::vector<SampleRgb>* leaf_out = nullptr);
 
 }  // namespace radiosity

@@ -42,7 +42,7 @@ struct OneLink {
   }
   double push_pull_once() {
     const LinkGather g = gather();
-    return push_pull(h, g, {}, {}, {});
+    return push_pull(h, g, {}, {}, {}, {});
   }
   Scene scene;
   Hierarchy h;
@@ -111,7 +111,7 @@ TEST(GatheredAtLeaves, MatchesWhatPushPullUses) {
   const LinkGather g = s.gather();
   const std::vector<SampleRgb> leaves = gathered_at_leaves(s.h, g, {});
   std::vector<SampleRgb> used(s.h.elements().size());
-  push_pull(s.h, g, {}, {}, {}, &used);
+  push_pull(s.h, g, {}, {}, {}, {}, &used);
   for (std::int32_t c = first; c < first + 4; ++c)
     for (size_t k = 0; k < kMaxSamples; ++k) {
       EXPECT_EQ(leaves[static_cast<size_t>(c)][k], used[static_cast<size_t>(c)][k]);

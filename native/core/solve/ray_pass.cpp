@@ -359,6 +359,8 @@ RayPass ray_pass(const Hierarchy& hierarchy, const RayScene& occluders,
     reflected.swap(next);
     if (!(change > kTolerance * total)) break;
   }
+  pass.met = std::move(met);
+  pass.lighting_rays = std::move(lighting_rays);
   pass.complete = true;
   return pass;
 }

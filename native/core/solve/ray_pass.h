@@ -50,6 +50,12 @@ struct RayPass {
   // (Solver::drop_links_light_cannot_reach drops them after linking), yet
   // the insides of a dense closed mesh face each other at every distance.
   std::vector<std::uint8_t> unlit;
+  // Per reflecting top-level element, its `rays` cosine rays: the top-level
+  // element each met first (kNone: the sky, or the back of a one-sided face),
+  // at met[element * rays + k]; and how many of its rays brought direct light
+  // (an emitter's, a light's or the sky's). What dim_sides.h reads.
+  std::vector<std::int32_t> met;
+  std::vector<std::uint32_t> lighting_rays;
   int rays = 0;        // per reflecting top-level element
   int iterations = 0;  // Jacobi iterations
   bool complete = false;

@@ -36,7 +36,8 @@ RelightRefusal options_refusal(const SolveOptions& a, const SolveOptions& b) {
   if (a.visibility != b.visibility || a.rays != b.rays) return RelightRefusal::VisibilityChanged;
   if (a.bounces || b.bounces) return RelightRefusal::FixedBounces;
   if (a.min_element_area != b.min_element_area) return RelightRefusal::SmallestElementChanged;
-  if (a.leaf_links != b.leaf_links || a.cluster_separation != b.cluster_separation)
+  if (a.leaf_links != b.leaf_links || a.cluster_separation != b.cluster_separation ||
+      a.dim_share != b.dim_share)
     return RelightRefusal::LinkingChanged;
   return RelightRefusal::None;
 }

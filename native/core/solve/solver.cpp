@@ -14,6 +14,7 @@
 #include "core/hierarchy/make_output_mesh.h"
 #include "core/solve/cluster_links.h"
 #include "core/solve/convergence.h"
+#include "core/solve/dim_sides.h"
 #include "core/solve/direct_light.h"
 #include "core/solve/energy_balance.h"
 #include "core/solve/gather.h"
@@ -190,6 +191,10 @@ class Solver {
   // that reaches it, and what each element gathers from them at its samples.
   std::vector<LightLink> light_links_;
   std::vector<SampleRgb> direct_light_;
+  // Sides too dim to link, which gather by rays, and what every side gathers
+  // by rays (dim_sides.h).
+  DimSides dim_sides_;
+  std::vector<Rgb> ray_light_;
   std::uint64_t light_version_ = 1, direct_version_ = 0;
   std::uint64_t links_version_ = 1, grouped_version_ = 0;
   SolveResult result_;       // the last complete pass
@@ -244,7 +249,8 @@ void Solver::track_memory() {
                          source_.capacity() * sizeof(Rgb) + clusters_.memory_bytes() +
                          cluster_gather_.memory_bytes() +
                          far_light_.capacity() * sizeof(SampleRgb) + balance_.memory_bytes() +
-                         direct_light_.capacity() * sizeof(SampleRgb);
+                         direct_light_.capacity() * sizeof(SampleRgb) + dim_sides_.memory_bytes() +
+                         ray_light_.capacity() * sizeof(Rgb);
   stats_.link_bytes = links_.capacity() * sizeof(Link) + order_.capacity() * sizeof(std::uint32_t) +
                       cluster_links_.capacity() * sizeof(ClusterLink) +
                       light_links_.capacity() * sizeof(LightLink);
@@ -289,11 +295,20 @@ void Solver::look_by_rays() {
     result_.stats = shown;
   }
   if (pass.complete) {
-    balance_.set_escaped(std::move(pass.escaped));
-    // Sides no light reaches take no part in linking (RayPass::unlit).
-    stats_.unlit_sides =
-        static_cast<std::size_t>(std::count(pass.unlit.begin(), pass.unlit.end(), 1));
-    if (stats_.unlit_sides) clusters_ = ClusterTree(hierarchy_, pass.unlit);
+    // Sides no light reaches (RayPass::unlit) and sides too dim to link
+    // (dim_sides.h) take no part in linking; what reaches the dim ones
+    // leaves by rays, not links, as what escapes does (energy_balance.h).
+    dim_sides_ = DimSides(hierarchy_, pass, options_.dim_share);
+    std::vector<float> escaped = std::move(pass.escaped);
+    std::vector<std::uint8_t> left_out = std::move(pass.unlit);
+    stats_.unlit_sides = static_cast<std::size_t>(std::count(left_out.begin(), left_out.end(), 1));
+    stats_.dim_sides = dim_sides_.count();
+    for (size_t e = 0; e < dim_sides_.dim().size(); ++e) {
+      escaped[e] = std::min(1.0f, escaped[e] + dim_sides_.share_to_dim()[e]);
+      left_out[e] |= dim_sides_.dim()[e];
+    }
+    balance_.set_escaped(std::move(escaped));
+    if (stats_.unlit_sides || stats_.dim_sides) clusters_ = ClusterTree(hierarchy_, left_out);
   }
   stats_.seconds_ray_pass = seconds_since(start);
   if (pass.complete) report(SolvePhase::Linking, 0.0, &result_);  // shown while linking runs
@@ -356,6 +371,8 @@ void Solver::link_initially() {
   if (cluster_links_.empty()) clusters_.release();
   for (const Link& l : links_) hierarchy_.element(l.receiver).has_links = 1;
   for (const LightLink& l : light_links_) hierarchy_.element(l.receiver).has_links = 1;
+  for (size_t e = 0; e < dim_sides_.dim().size(); ++e)  // shown, with what their rays gather
+    if (dim_sides_.dim()[e]) hierarchy_.element(static_cast<std::int32_t>(e)).has_links = 1;
   links_.shrink_to_fit();
   hierarchy_.shrink_to_fit();
   ++links_version_;
@@ -568,8 +585,9 @@ double Solver::gather_push_pull() {
   balance_.sent_radiances(hierarchy_, source_);
   gather_far_light();
   gather_direct_light();
+  if (!dim_sides_.empty()) dim_sides_.gather(hierarchy_, ray_light_);
   return push_pull(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_,
-                   balance_.down_scale(), direct_light_);
+                   balance_.down_scale(), direct_light_, ray_light_);
 }
 
 // Refine, gather, push/pull until converged (or `max_iterations`); refinement
@@ -617,9 +635,9 @@ void Solver::snapshot(double threshold) {
   source_.resize(hierarchy_.elements().size(), Rgb(0.0));
   group_links();
   gather_far_light();
-  gather_direct_light();
+  gather_direct_light();  // ray_light_: as the last iteration gathered it
   push_pull(hierarchy_, LinkGather{hierarchy_, links_, offset_, order_, source_}, far_light_,
-            balance_.down_scale(), direct_light_, &leaf);
+            balance_.down_scale(), direct_light_, ray_light_, &leaf);
   result_.mesh = make_output_mesh(hierarchy_, leaf);
   stats_.threshold = threshold;
   count(stats_);

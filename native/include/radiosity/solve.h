@@ -98,6 +98,10 @@ struct SolveOptions {
   // (cluster_links.h); infinity: every pair of patch sides is linked;
   // 0: from the quality, 2 at 0 to 10 at 1.
   double cluster_separation = 0.0;
+  // Sides no ray of the first look brought direct light to, and whose light
+  // there is below this share of the mean, gather by rays instead of links
+  // (dim_sides.h); 0: every side light reaches is linked.
+  double dim_share = 0.02;
   double tolerance = 1e-6;  // relative change of radiance that counts as converged
   int max_iterations = 5000;
 };
@@ -123,7 +127,7 @@ enum class RelightRefusal : std::uint8_t {
   VisibilityChanged,       // the visibility mode or its rays
   FixedBounces,            // a fixed number of bounces was asked (then or now)
   SmallestElementChanged,  // min_element_area
-  LinkingChanged,          // leaf_links or cluster_separation
+  LinkingChanged,          // leaf_links, cluster_separation or dim_share
   GeometryChanged,
   LightsAddedOrRemoved,  // or turned on or off (a light that gives nothing is left out)
   LightChanged,          // a light moved or changed shape
@@ -213,8 +217,9 @@ struct SolveStats {
   double seconds_ray_pass = 0.0;    // the rough look before linking (ray_pass.h)
   int ray_pass_rays = 0;            // its rays per reflecting top-level element
   std::size_t unlit_sides = 0;      // top-level sides it found no light reaches: not linked
-  LinkTimings link_cpu;             // CPU seconds over all threads
-  double seconds_gather = 0.0;      // gather and push/pull, wall clock
+  std::size_t dim_sides = 0;  // top-level sides too dim to link: they gather by rays (dim_sides.h)
+  LinkTimings link_cpu;       // CPU seconds over all threads
+  double seconds_gather = 0.0;  // gather and push/pull, wall clock
   std::size_t element_bytes = 0;
   std::size_t link_bytes = 0;
   std::size_t peak_bytes = 0;  // peak of the solver's own structures
