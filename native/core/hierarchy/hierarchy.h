@@ -82,6 +82,8 @@ class Hierarchy {
   const PatchSide& side_of(const Element& e) const { return patch_of(e).sides[e.side]; }
   Rgb reflectance(const Element& e) const { return side_of(e).reflectance; }
   Rgb emission(const Element& e) const { return side_of(e).emission; }
+  // Whether the element's side reflects light (can receive it).
+  bool reflects(const Element& e) const { return luminance(reflectance(e)) > 0.0; }
 
   // Corner positions, counter-clockwise about the side's normal.
   int corners(const Element& e, dvec3* out) const;

@@ -8,14 +8,12 @@
 namespace radiosity {
 namespace {
 
-bool reflects(const Hierarchy& h, const Element& e) { return luminance(h.reflectance(e)) > 0.0; }
-
 // The top-level sides light reaches that reflect: the ones linking is for.
 std::vector<std::int32_t> lit_sides(const Hierarchy& h, const RayPass& pass) {
   std::vector<std::int32_t> out;
   for (std::size_t r = 0; r < h.root_count(); ++r) {
     const std::int32_t id = h.root(static_cast<std::uint32_t>(r / 2), static_cast<int>(r % 2));
-    if (id != kNone && reflects(h, h.element(id)) && !pass.unlit[static_cast<std::size_t>(id)])
+    if (id != kNone && h.reflects(h.element(id)) && !pass.unlit[static_cast<std::size_t>(id)])
       out.push_back(id);
   }
   return out;

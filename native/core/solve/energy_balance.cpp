@@ -32,8 +32,6 @@ constexpr double kClosed = 1.0 - 1e-3;
 // at 0.1, the sun through a window agreed 0.5 to 0.8 % worse with Cycles.
 constexpr double kTrustRays = 0.005;
 
-bool reflects(const Hierarchy& h, const Element& e) { return luminance(h.reflectance(e)) > 0.0; }
-
 using SampleWeights = std::array<double, kMaxSamples>;
 
 // Per element e, the weights w with which the light a link leaves at e's
@@ -197,7 +195,7 @@ void EnergyBalance::update(const Hierarchy& h, const LinkGather& grouping, const
   std::vector<Rgb> partners(n);
   for (size_t e = 0; e < n; ++e) {
     const bool opaque = h.patch_of(elements[e]).occludes;
-    partners[e] = Rgb(opaque ? 1.0 : 0.0, reflects(h, elements[e]) ? 1.0 : 0.0, 0.0);
+    partners[e] = Rgb(opaque ? 1.0 : 0.0, h.reflects(elements[e]) ? 1.0 : 0.0, 0.0);
   }
   const LinkGather coverage{grouping.hierarchy, grouping.links, grouping.offset, grouping.order,
                             partners};
@@ -284,7 +282,7 @@ void EnergyBalance::update(const Hierarchy& h, const LinkGather& grouping, const
   std::vector<double> closed(h.root_count(), 0.0), sent(h.root_count(), 0.0);
   for (size_t e = 0; e < n; ++e) {
     const Element& l = elements[e];
-    if (!l.is_leaf() || !l.has_links || !reflects(h, l)) continue;
+    if (!l.is_leaf() || !l.has_links || !h.reflects(l)) continue;
     const double c = receiving[e];
     const double d = delivered[e];
     if (!(c > 0.0) || !(d > 0.0)) continue;

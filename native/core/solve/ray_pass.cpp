@@ -75,8 +75,6 @@ dvec3 cosine_direction(const dvec3& n, int k, int count, SplitMix64& random) {
   return r * std::cos(phi) * t + r * std::sin(phi) * b + std::sqrt(std::max(0.0, 1.0 - u)) * n;
 }
 
-bool reflects(const Hierarchy& h, const Element& e) { return luminance(h.reflectance(e)) > 0.0; }
-
 }  // namespace
 
 int ray_pass_rays(std::size_t reflecting) {
@@ -187,7 +185,7 @@ std::vector<std::uint8_t> sides_no_light_reaches(const Hierarchy& hierarchy,
   std::vector<std::uint8_t> unlit(count, 0);
   for (std::int32_t id : root_element) {
     const auto i = static_cast<std::size_t>(id);
-    unlit[i] = !reached[i] && reflects(hierarchy, hierarchy.element(id));
+    unlit[i] = !reached[i] && hierarchy.reflects(hierarchy.element(id));
   }
   return unlit;
 }
@@ -211,7 +209,7 @@ RayPass ray_pass(const Hierarchy& hierarchy, const RayScene& occluders,
           : static_cast<std::size_t>(*std::max_element(root_element.begin(), root_element.end())) +
                 1;
   std::size_t reflecting = 0;
-  for (std::int32_t e : root_element) reflecting += reflects(hierarchy, hierarchy.element(e));
+  for (std::int32_t e : root_element) reflecting += hierarchy.reflects(hierarchy.element(e));
   Rgb sky(0.0);
   for (const Light& light : scene.lights)
     if (light.kind == LightKind::Sky) sky += light.colour;
@@ -254,7 +252,7 @@ RayPass ray_pass(const Hierarchy& hierarchy, const RayScene& occluders,
           const std::int32_t id = root_element[i];
           const auto at = static_cast<std::size_t>(id);
           const Element& e = hierarchy.element(id);
-          if (!reflects(hierarchy, e)) continue;
+          if (!hierarchy.reflects(e)) continue;
           dvec3 corner[4];
           hierarchy.corners(e, corner);
           const dvec3 n = hierarchy.normal(e);
