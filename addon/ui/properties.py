@@ -22,8 +22,10 @@ from ..model.solver_defaults import SOLVER_DEFAULTS
 
 VISIBILITY_ITEMS = (
     ('EXACT', "Exact",
-     "Shadows computed exactly: clean edges and smooth penumbrae; slower in "
-     "cluttered scenes (each light clipped against its occluders)"),
+     "Shadows computed exactly wherever they can show: clean edges and smooth "
+     "penumbrae; slower in cluttered scenes (each light clipped against its "
+     "occluders). With the Standard and Noticeable oracles, light under a "
+     "fiftieth of what a surface gathers is shadowed with rays"),
     ('SAMPLED', "Sampled",
      "Shadows estimated with rays: faster in cluttered scenes, slightly noisy "
      "penumbrae (more Rays, less noise), and shadow edges may get less detail "

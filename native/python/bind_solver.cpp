@@ -260,6 +260,7 @@ py::dict stats_dict(const SolveStats& s) {
   d["cpu_oracle"] = s.link_cpu.oracle;
   d["samples_clear"] = s.link_cpu.samples_clear;
   d["samples_occluded"] = s.link_cpu.samples_occluded;
+  d["samples_faint"] = s.link_cpu.samples_faint;
   d["samples_shared"] = s.link_cpu.samples_shared;
   d["element_bytes"] = s.element_bytes;
   d["link_bytes"] = s.link_bytes;
@@ -359,7 +360,7 @@ SolveOptions read_options(const std::string& oracle, double quality, const py::o
                           const py::object& rays, const py::object& bounces,
                           const py::object& threads, double min_element_area,
                           const std::string& leaf_links, std::optional<double> cluster_separation,
-                          double dim_share, const py::object& memory_limit,
+                          double dim_share, double faint_share, const py::object& memory_limit,
                           bool yield_to_interface) {
   SolveOptions options;
   options.oracle = read_oracle(oracle);
@@ -391,6 +392,9 @@ SolveOptions read_options(const std::string& oracle, double quality, const py::o
   if (!(dim_share >= 0.0 && dim_share <= 1.0))
     throw std::invalid_argument("dim_share must lie in [0, 1] (0: every lit side is linked)");
   options.dim_share = dim_share;
+  if (!(faint_share >= 0.0 && faint_share <= 1.0))
+    throw std::invalid_argument("faint_share must lie in [0, 1] (0: every sample exact)");
+  options.faint_share = faint_share;
   const auto links = parse_leaf_links(leaf_links);
   if (!links)
     throw std::invalid_argument("leaf_links must be 'none', 'near' or 'all', got '" + leaf_links +
@@ -485,13 +489,13 @@ PyResult py_solve(const Scene& scene, const std::string& oracle, double quality,
                   const std::string& visibility, const py::object& rays, const py::object& bounces,
                   const py::object& threads, const py::object& progress, const py::object& cancel,
                   double min_element_area, const std::string& leaf_links,
-                  std::optional<double> cluster_separation, double dim_share,
+                  std::optional<double> cluster_separation, double dim_share, double faint_share,
                   const py::object& memory_limit, bool pass_results, bool yield_to_interface,
                   const py::object& reuse, const py::object& clock) {
   SolveOptions options =
       read_options(oracle, quality, max_elements, time_budget, visibility, rays, bounces, threads,
-                   min_element_area, leaf_links, cluster_separation, dim_share, memory_limit,
-                   yield_to_interface);
+                   min_element_area, leaf_links, cluster_separation, dim_share, faint_share,
+                   memory_limit, yield_to_interface);
   PyReuse* kept = nullptr;
   if (!reuse.is_none()) {
     if (!py::isinstance<PyReuse>(reuse))
@@ -696,7 +700,9 @@ void bind_solver(py::module_& m) {
       "cluster_separation: clusters of faces this many times their radii apart share one link\n"
       "(default from quality, 2 to 10; inf: none); dim_share: sides no ray brought direct light\n"
       "whose first-look light is below this share of the mean gather by rays, not links (0: "
-      "none);\nmemory_limit: bytes the elements and links "
+      "none);\nfaint_share: with exact visibility, a sample whose unoccluded light from a link is\n"
+      "below this share of its side's first-look light is shadowed by rays (0: all exact);\n"
+      "memory_limit: bytes the elements and links "
       "may hold\n"
       "(default 3/4 of the available memory): refinement stops there (stats['stopped_by'] == "
       "'memory'),\n"
@@ -718,9 +724,9 @@ void bind_solver(py::module_& m) {
         py::arg("cancel") = py::none(), py::arg("min_element_area") = defaults.min_element_area,
         py::arg("leaf_links") = std::string(leaf_links_name(defaults.leaf_links)),
         py::arg("cluster_separation") = py::none(), py::arg("dim_share") = defaults.dim_share,
-        py::arg("memory_limit") = py::none(), py::arg("pass_results") = false,
-        py::arg("yield_to_interface") = false, py::arg("reuse") = py::none(),
-        py::arg("clock") = py::none(), solve_doc.c_str());
+        py::arg("faint_share") = defaults.faint_share, py::arg("memory_limit") = py::none(),
+        py::arg("pass_results") = false, py::arg("yield_to_interface") = false,
+        py::arg("reuse") = py::none(), py::arg("clock") = py::none(), solve_doc.c_str());
 
   m.def(
       "quality_threshold",

@@ -323,6 +323,23 @@ bool finish(const LinkEvaluator& evaluator, Link& link, const LinkEnds& ends, Sa
   return true;
 }
 
+// Which samples of a link shadow rays serve, with exact visibility
+// (faint_samples.h); true where all of them do.
+bool faint_samples(const LinkEvaluator& evaluator, const Element& receiver, const Element& emitter,
+                   const LinkEnds& ends, std::array<bool, kMaxSamples>& by_rays) {
+  const Hierarchy& h = evaluator.hierarchy;
+  const std::int32_t receiver_side = h.root(receiver.patch, receiver.side);
+  const std::int32_t emitter_side = h.root(emitter.patch, emitter.side);
+  bool all = true;
+  for (int s = 0; s < ends.ns; ++s) {
+    const bool faint = evaluator.faint->faint(
+        receiver_side, emitter_side, form_factor(ends.x[s], ends.n, ends.emitter_polygon()));
+    by_rays[static_cast<size_t>(s)] = faint;
+    all = all && faint;
+  }
+  return all;
+}
+
 }  // namespace
 
 bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo) const {
@@ -335,10 +352,14 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo)
   const std::span<const dvec3> emitter_polygon = ends.emitter_polygon();
 
   auto start = Clock::now();
+  // Which samples shadow rays serve, before any visibility work: where all of
+  // them do, the shaft is culled as sampled visibility culls it.
+  std::array<bool, kMaxSamples> by_rays{};
+  const bool all_by_rays = visibility == VisibilityMode::Sampled ||
+                           (visibility == VisibilityMode::Exact && faint && !faint->empty() &&
+                            faint_samples(*this, receiver, emitter, ends, by_rays));
   // Shadow rays need no list of occluders: past the crossover, stop looking.
-  const std::size_t limit = visibility == VisibilityMode::Sampled
-                                ? kRayCrossover
-                                : std::numeric_limits<std::size_t>::max();
+  const std::size_t limit = all_by_rays ? kRayCrossover : std::numeric_limits<std::size_t>::max();
   const ShaftCulling culling =
       cull_shaft(occluders.shafts, ends.receiver_polygon(), hierarchy.patch_of(receiver).surface,
                  emitter_polygon, hierarchy.patch_of(emitter).surface, limit);
@@ -371,7 +392,7 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo)
     } else if (culling.visibility == ShaftVisibility::clear) {
       ++timings.samples_clear;
       f = unoccluded(*this, x, ends.n, emitter_polygon);
-    } else if (visibility == VisibilityMode::Exact) {
+    } else if (visibility == VisibilityMode::Exact && !by_rays[static_cast<size_t>(s)]) {
       ++timings.samples_occluded;
       // The standard oracle reads no gradient: F alone is cheaper.
       f = oracle_needs_gradient(oracle)
@@ -386,8 +407,9 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo)
       // Few candidates: test them directly in double precision; many: let
       // Embree traverse the scene.
       ++timings.samples_occluded;
+      timings.samples_faint += visibility == VisibilityMode::Exact;
       const SampledVisibilityOptions options{rays, static_cast<std::uint64_t>(s)};
-      f = culling.truncated
+      f = culling.truncated || candidates.size() > kRayCrossover
               ? sampled_form_factor_gradient(x, ends.n, emitter_polygon, *occluders.rays, options,
                                              hierarchy.patch_of(receiver).surface,
                                              hierarchy.patch_of(emitter).surface, &values.open[s])
@@ -406,12 +428,18 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo)
 void LinkEvaluator::evaluate_emitter_siblings(std::span<Link> links, LinkTimings& timings,
                                               std::span<std::uint8_t> visible) const {
   const size_t count = links.size();
-  if (visibility != VisibilityMode::Exact || count < 2 || count > 4) {
+  const auto one_by_one = [&] {
     for (size_t i = 0; i < count; ++i) visible[i] = evaluate(links[i], timings) ? 1 : 0;
-    return;
-  }
+  };
+  if (visibility != VisibilityMode::Exact || count < 2 || count > 4) return one_by_one();
   const Element& receiver = hierarchy.element(links[0].receiver);
   const Element& parent = hierarchy.element(hierarchy.element(links[0].emitter).parent);
+  // Where the parent's light is faint at every sample, so is each child's (a
+  // part of it): their samples all take rays, one link at a time.
+  std::array<bool, kMaxSamples> by_rays{};
+  if (faint && !faint->empty() &&
+      faint_samples(*this, receiver, parent, link_ends(hierarchy, receiver, parent), by_rays))
+    return one_by_one();
   // The children that face the receiver; their polygons are the parts.
   std::array<LinkEnds, 4> ends;
   std::array<std::span<const dvec3>, 4> parts;

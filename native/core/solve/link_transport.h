@@ -14,6 +14,7 @@
 #include "core/geometry/form_factor.h"
 #include "core/hierarchy/emitter_shape.h"
 #include "core/hierarchy/hierarchy.h"
+#include "core/solve/faint_samples.h"
 #include "core/solve/oracle.h"
 #include "core/visibility/occluders.h"
 #include "core/visibility/ray_scene.h"
@@ -73,6 +74,9 @@ struct LinkEvaluator {
   int rays = 16;
   Oracle oracle = Oracle::Standard;
   double geometric_scale = 1.0;  // oracle_geometric_scale() of the scene
+  // With exact visibility, the samples shadowed by rays instead; null or
+  // empty: none.
+  const FaintSamples* faint = nullptr;
 
   // Fills `link.form_factor` and `link.oracle`; false when the emitter is not
   // seen from any sample (facing away, coplanar or fully hidden). With a memo,

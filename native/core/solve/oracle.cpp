@@ -7,6 +7,10 @@ namespace radiosity {
 
 bool oracle_needs_gradient(Oracle oracle) { return oracle != Oracle::Standard; }
 
+bool oracle_judges_by_gradients(Oracle oracle) {
+  return oracle == Oracle::Perceptual || oracle == Oracle::Gradient;
+}
+
 namespace {
 
 // A twentieth of sqrt(A): 45 cm in an 80 m2 room. Measured on the study's

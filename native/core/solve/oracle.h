@@ -20,6 +20,11 @@ namespace radiosity {
 
 bool oracle_needs_gradient(Oracle oracle);
 
+// The perceptual and gradient oracles judge a link by how its gradients differ
+// between samples, so they need the gradients exact visibility gives, with
+// occlusion: shadow rays' gradients ignore occluders (faint_samples.h).
+bool oracle_judges_by_gradients(Oracle oracle);
+
 // The receiver's samples of one link: form factor and its gradient at each.
 struct LinkSamples {
   std::span<const dvec3> position;

@@ -33,7 +33,8 @@ bool same_geometry(const Light& a, const Light& b) {
 RelightRefusal options_refusal(const SolveOptions& a, const SolveOptions& b) {
   if (a.oracle != b.oracle) return RelightRefusal::OracleChanged;
   if (a.quality != b.quality) return RelightRefusal::QualityChanged;
-  if (a.visibility != b.visibility || a.rays != b.rays) return RelightRefusal::VisibilityChanged;
+  if (a.visibility != b.visibility || a.rays != b.rays || a.faint_share != b.faint_share)
+    return RelightRefusal::VisibilityChanged;
   if (a.bounces || b.bounces) return RelightRefusal::FixedBounces;
   if (a.min_element_area != b.min_element_area) return RelightRefusal::SmallestElementChanged;
   if (a.leaf_links != b.leaf_links || a.cluster_separation != b.cluster_separation ||

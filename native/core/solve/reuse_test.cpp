@@ -60,6 +60,9 @@ TEST(RelightRefusal, OptionsTheLinksWereMadeWithMayNot) {
             RelightRefusal::OracleChanged);
   EXPECT_EQ(refusal([](SolveOptions& o) { o.quality = 0.7; }), RelightRefusal::QualityChanged);
   EXPECT_EQ(refusal([](SolveOptions& o) { o.rays = 64; }), RelightRefusal::VisibilityChanged);
+  EXPECT_EQ(refusal([](SolveOptions& o) { o.faint_share = 0.0; }),
+            RelightRefusal::VisibilityChanged);
+  EXPECT_EQ(refusal([](SolveOptions& o) { o.dim_share = 0.0; }), RelightRefusal::LinkingChanged);
   EXPECT_EQ(refusal([](SolveOptions& o) { o.bounces = 3; }), RelightRefusal::FixedBounces);
   EXPECT_EQ(refusal([](SolveOptions& o) { o.min_element_area = 1e-3; }),
             RelightRefusal::SmallestElementChanged);

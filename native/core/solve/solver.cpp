@@ -195,6 +195,9 @@ class Solver {
   // by rays (dim_sides.h).
   DimSides dim_sides_;
   std::vector<Rgb> ray_light_;
+  // With exact visibility, the samples whose light from a link is faint
+  // enough for shadow rays (faint_samples.h).
+  FaintSamples faint_;
   std::uint64_t light_version_ = 1, direct_version_ = 0;
   std::uint64_t links_version_ = 1, grouped_version_ = 0;
   SolveResult result_;       // the last complete pass
@@ -250,7 +253,7 @@ void Solver::track_memory() {
                          cluster_gather_.memory_bytes() +
                          far_light_.capacity() * sizeof(SampleRgb) + balance_.memory_bytes() +
                          direct_light_.capacity() * sizeof(SampleRgb) + dim_sides_.memory_bytes() +
-                         ray_light_.capacity() * sizeof(Rgb);
+                         ray_light_.capacity() * sizeof(Rgb) + faint_.memory_bytes();
   stats_.link_bytes = links_.capacity() * sizeof(Link) + order_.capacity() * sizeof(std::uint32_t) +
                       cluster_links_.capacity() * sizeof(ClusterLink) +
                       light_links_.capacity() * sizeof(LightLink);
@@ -299,6 +302,14 @@ void Solver::look_by_rays() {
     // (dim_sides.h) take no part in linking; what reaches the dim ones
     // leaves by rays, not links, as what escapes does (energy_balance.h).
     dim_sides_ = DimSides(hierarchy_, pass, options_.dim_share);
+    // Measured: with rays at faint samples the gradient oracle made 387
+    // elements instead of 843 on a picture 1 mm in front of a wall, 0.4 %
+    // darker against Cycles; standard and Noticeable made the same ones.
+    if (options_.visibility == VisibilityMode::Exact &&
+        !oracle_judges_by_gradients(options_.oracle)) {
+      faint_ = FaintSamples(hierarchy_, pass, options_.faint_share);
+      evaluator_.faint = &faint_;
+    }
     std::vector<float> escaped = std::move(pass.escaped);
     std::vector<std::uint8_t> left_out = std::move(pass.unlit);
     stats_.unlit_sides = static_cast<std::size_t>(std::count(left_out.begin(), left_out.end(), 1));

@@ -102,6 +102,11 @@ struct SolveOptions {
   // there is below this share of the mean, gather by rays instead of links
   // (dim_sides.h); 0: every side light reaches is linked.
   double dim_share = 0.02;
+  // With exact visibility and the standard or Noticeable oracle: a sample
+  // whose unoccluded light from a link is below this share of what its side
+  // gathered in the ray pass is shadowed by `rays` shadow rays instead
+  // (faint_samples.h); 0: every sample exact.
+  double faint_share = 0.02;
   double tolerance = 1e-6;  // relative change of radiance that counts as converged
   int max_iterations = 5000;
 };
@@ -124,7 +129,7 @@ enum class RelightRefusal : std::uint8_t {
   NothingKept,    // no complete solve was kept yet
   OracleChanged,  // options the links were made with changed: ...
   QualityChanged,
-  VisibilityChanged,       // the visibility mode or its rays
+  VisibilityChanged,       // the visibility mode, its rays or faint_share
   FixedBounces,            // a fixed number of bounces was asked (then or now)
   SmallestElementChanged,  // min_element_area
   LinkingChanged,          // leaf_links, cluster_separation or dim_share
@@ -175,13 +180,16 @@ struct SolveProgress {
 
 // CPU seconds spent in each part of link evaluation (summed over threads), and
 // how many form factors were computed: clear of occluders, through the visible
-// polygon or shadow rays, or taken from a sibling (CornerMemo).
+// polygon or shadow rays (occluded; of them, by rays where exact visibility
+// found the sample's light faint: faint_samples.h), or taken from a sibling
+// (CornerMemo).
 struct LinkTimings {
   double visibility = 0.0;
   double form_factors = 0.0;
   double oracle = 0.0;
   std::uint64_t samples_clear = 0;
   std::uint64_t samples_occluded = 0;
+  std::uint64_t samples_faint = 0;
   std::uint64_t samples_shared = 0;
   LinkTimings& operator+=(const LinkTimings& o) {
     visibility += o.visibility;
@@ -189,6 +197,7 @@ struct LinkTimings {
     oracle += o.oracle;
     samples_clear += o.samples_clear;
     samples_occluded += o.samples_occluded;
+    samples_faint += o.samples_faint;
     samples_shared += o.samples_shared;
     return *this;
   }
