@@ -211,9 +211,11 @@ double conserve_energy(const Element& receiver, const AverageWeights& weights, c
 }
 
 // Stores the sample form factors and the oracle's geometric criterion; false
-// when no sample sees the emitter.
+// when no sample sees the emitter. `by_rays`: every sample took shadow rays,
+// and the candidates may stop at the crossover (no exact grid from them).
 bool finish(const LinkEvaluator& evaluator, Link& link, const LinkEnds& ends, SampleValues values,
-            bool unoccluded, LinkTimings& timings, std::span<const Triangle> candidates) {
+            bool unoccluded, bool by_rays, LinkTimings& timings,
+            std::span<const Triangle> candidates) {
   const Hierarchy& hierarchy = evaluator.hierarchy;
   const Element& receiver = hierarchy.element(link.receiver);
   const double* value = values.value;
@@ -293,8 +295,7 @@ bool finish(const LinkEvaluator& evaluator, Link& link, const LinkEnds& ends, Sa
   const AverageWeights weights = hierarchy.average_weights(receiver);
   const double before =
       judges_correction ? sample_average(weights, receiver.corner_count, values.value) : 0.0;
-  const bool grid = !unoccluded && evaluator.visibility == VisibilityMode::Exact &&
-                    hierarchy.samples_inset(receiver);
+  const bool grid = !unoccluded && !by_rays && hierarchy.samples_inset(receiver);
   const double shadow_contrast =
       conserve_energy(receiver, weights, ends, unoccluded, values, grid ? &candidates : nullptr);
   for (int s = 0; s < ends.ns; ++s)
@@ -421,8 +422,8 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo)
     values.grad[s] = f.gradient;
   }
   timings.form_factors += seconds_since(start);
-  return finish(*this, link, ends, values, culling.visibility == ShaftVisibility::clear, timings,
-                candidates);
+  return finish(*this, link, ends, values, culling.visibility == ShaftVisibility::clear,
+                all_by_rays, timings, candidates);
 }
 
 void LinkEvaluator::evaluate_emitter_siblings(std::span<Link> links, LinkTimings& timings,
@@ -493,10 +494,11 @@ void LinkEvaluator::evaluate_emitter_siblings(std::span<Link> links, LinkTimings
   }
   timings.form_factors += seconds_since(start);
   for (size_t k = 0; k < facing; ++k)
-    visible[which[k]] = finish(*this, links[which[k]], ends[k], values[k],
-                               culling.visibility == ShaftVisibility::clear, timings, candidates)
-                            ? 1
-                            : 0;
+    visible[which[k]] =
+        finish(*this, links[which[k]], ends[k], values[k],
+               culling.visibility == ShaftVisibility::clear, false, timings, candidates)
+            ? 1
+            : 0;
 }
 
 }  // namespace radiosity
