@@ -262,6 +262,7 @@ py::dict stats_dict(const SolveStats& s) {
   d["samples_occluded"] = s.link_cpu.samples_occluded;
   d["samples_faint"] = s.link_cpu.samples_faint;
   d["samples_shared"] = s.link_cpu.samples_shared;
+  d["grid_points_faint"] = s.link_cpu.grid_points_faint;
   d["element_bytes"] = s.element_bytes;
   d["link_bytes"] = s.link_bytes;
   d["peak_bytes"] = s.peak_bytes;

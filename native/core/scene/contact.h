@@ -13,7 +13,9 @@
 // - Q parallel to P (within 5 degrees) and no further from P's plane than a
 //   tenth of the smaller one's diameter: P is split along the outline of Q's
 //   projection onto it (the floor under a box, the ceiling behind a light, the
-//   wall behind a picture, down to a light 1 cm under a ceiling);
+//   wall behind a picture, down to a light 1 cm under a ceiling), if that
+//   projection overlaps P: the next face of a smooth mesh, bent by a degree,
+//   only borders P and is no cover;
 // - Q passes through P's plane: P is split along the segment they share
 //   (a plate through a wall);
 // - an edge of Q touches P's plane (within a hundredth of Q's diameter): P is

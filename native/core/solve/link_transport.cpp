@@ -111,6 +111,24 @@ FormFactorGradient unoccluded(const LinkEvaluator& evaluator, const dvec3& x, co
              : FormFactorGradient{form_factor(x, n, emitter), dvec3(0.0)};
 }
 
+// A point's form factor through shadow rays: tested against the candidates
+// when few, through Embree's scene when many or when the list stopped at the
+// crossover. The seed varies with the point so that neighbours do not share
+// one stratification pattern.
+FormFactorGradient shadowed_by_rays(const LinkEvaluator& evaluator, const Element& receiver,
+                                    const Element& emitter, const dvec3& x, const dvec3& n,
+                                    std::span<const dvec3> emitter_polygon,
+                                    std::span<const Triangle> candidates, bool truncated,
+                                    std::uint64_t seed, double* open) {
+  const SampledVisibilityOptions options{evaluator.rays, seed};
+  const Hierarchy& h = evaluator.hierarchy;
+  return truncated || candidates.size() > kRayCrossover
+             ? sampled_form_factor_gradient(x, n, emitter_polygon, *evaluator.occluders.rays,
+                                            options, h.patch_of(receiver).surface,
+                                            h.patch_of(emitter).surface, open)
+             : sampled_form_factor_gradient(x, n, emitter_polygon, candidates, options, open);
+}
+
 // The five samples integrate F over the receiver only approximately, badly
 // near an emitter (F grows quickly towards it): a link would move more or less
 // light than the two patches exchange (10 to 25 % at coarse levels, so energy
@@ -125,7 +143,18 @@ FormFactorGradient unoccluded(const LinkEvaluator& evaluator, const dvec3& x, co
 // gather's sum is what matters and the output clamps at zero. Where some
 // sample is partly hidden, the samples are scaled by F_pq / average instead
 // (see below).
-//
+
+// What the 3 x 3 grid of the energy correction (below) is shadowed by: the
+// link's candidate occluders, exactly, or by shadow rays at the points where
+// the link's light is faint (faint_samples.h), as at the samples.
+struct GridVisibility {
+  const LinkEvaluator& evaluator;
+  const Element& receiver;
+  const Element& emitter;
+  std::span<const Triangle> candidates;
+  std::uint64_t* points_faint;  // counts the points that took rays
+};
+
 // The five samples' visible share is poor where they sit on the outline of
 // something close to the receiver (contact.h insets them off it, so they are
 // no longer representative of the corners' regions: the ceiling around a
@@ -134,8 +163,12 @@ FormFactorGradient unoccluded(const LinkEvaluator& evaluator, const dvec3& x, co
 // of points over the element instead (a 4 x 4 grid cost 16 % of a furnished
 // room's solve and agreed with Cycles no better: test_contact, every case
 // within 0.1 %).
-double grid_visible_share(const LinkEnds& ends, int corner_count,
-                          std::span<const Triangle> occluders) {
+double grid_visible_share(const LinkEnds& ends, int corner_count, const GridVisibility& grid) {
+  const LinkEvaluator& evaluator = grid.evaluator;
+  const Hierarchy& h = evaluator.hierarchy;
+  const bool may_be_faint = evaluator.faint && !evaluator.faint->empty();
+  const std::int32_t receiver_side = h.root(grid.receiver.patch, grid.receiver.side);
+  const std::int32_t emitter_side = h.root(grid.emitter.patch, grid.emitter.side);
   double visible = 0.0, open = 0.0;
   const dvec3* c = ends.receiver_corners;
   constexpr int kGrid = 3;
@@ -143,7 +176,19 @@ double grid_visible_share(const LinkEnds& ends, int corner_count,
     for (int j = 0; j < kGrid; ++j) {
       const dvec3 x = grid_point(c, corner_count, i, j, kGrid);
       double unoccluded = 0.0;
-      visible += visible_form_factor(x, ends.n, ends.emitter_polygon(), occluders, &unoccluded);
+      if (may_be_faint && evaluator.faint->faint(receiver_side, emitter_side,
+                                                 form_factor(x, ends.n, ends.emitter_polygon()))) {
+        // Seeds past the samples' (0 .. kMaxSamples - 1).
+        const auto seed = static_cast<std::uint64_t>(kMaxSamples + i * kGrid + j);
+        visible +=
+            shadowed_by_rays(evaluator, grid.receiver, grid.emitter, x, ends.n,
+                             ends.emitter_polygon(), grid.candidates, false, seed, &unoccluded)
+                .value;
+        ++*grid.points_faint;
+      } else {
+        visible +=
+            visible_form_factor(x, ends.n, ends.emitter_polygon(), grid.candidates, &unoccluded);
+      }
       open += unoccluded;
     }
   }
@@ -162,8 +207,7 @@ double sample_average(const AverageWeights& weights, int corner_count, const dou
 // smallest): a shadow's edge lies between them, and the light beside it
 // reaches about the open value, which the samples' reconstruction cannot show.
 double conserve_energy(const Element& receiver, const AverageWeights& weights, const LinkEnds& ends,
-                       bool unoccluded, SampleValues& values,
-                       const std::span<const Triangle>* grid_occluders) {
+                       bool unoccluded, SampleValues& values, const GridVisibility* grid) {
   std::array<Rgb, kMaxSamples> open{}, in_front{};
   double visible[kMaxSamples] = {};
   double hidden_most = 0.0, hidden_least = std::numeric_limits<double>::infinity();
@@ -196,8 +240,8 @@ double conserve_energy(const Element& receiver, const AverageWeights& weights, c
     // under a box would go below zero and lose all its light). Scale them
     // instead: the link carries F_pq times the samples' visible share.
     double scale = exact / average;
-    if (grid_occluders) {
-      const double share = grid_visible_share(ends, receiver.corner_count, *grid_occluders);
+    if (grid) {
+      const double share = grid_visible_share(ends, receiver.corner_count, *grid);
       std::array<Rgb, kMaxSamples> seen{};
       for (int s = 0; s < ends.ns; ++s) seen[static_cast<size_t>(s)] = Rgb(values.value[s]);
       const double seen_average = Interpolant::average(weights, receiver.corner_count, seen).x;
@@ -296,8 +340,10 @@ bool finish(const LinkEvaluator& evaluator, Link& link, const LinkEnds& ends, Sa
   const double before =
       judges_correction ? sample_average(weights, receiver.corner_count, values.value) : 0.0;
   const bool grid = !unoccluded && !by_rays && hierarchy.samples_inset(receiver);
-  const double shadow_contrast =
-      conserve_energy(receiver, weights, ends, unoccluded, values, grid ? &candidates : nullptr);
+  const GridVisibility grid_visibility{evaluator, receiver, hierarchy.element(link.emitter),
+                                       candidates, &timings.grid_points_faint};
+  const double shadow_contrast = conserve_energy(receiver, weights, ends, unoccluded, values,
+                                                 grid ? &grid_visibility : nullptr);
   for (int s = 0; s < ends.ns; ++s)
     link.form_factor[static_cast<size_t>(s)] = static_cast<float>(values.value[s]);
   timings.form_factors += seconds_since(conserve_start);
@@ -403,19 +449,10 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo)
                     visible_form_factor(x, ends.n, emitter_polygon, candidates, &values.open[s]),
                     dvec3(0.0)};
     } else {
-      // Rays per sample vary their seed with the sample, so neighbours do not
-      // share the same stratification pattern.
-      // Few candidates: test them directly in double precision; many: let
-      // Embree traverse the scene.
       ++timings.samples_occluded;
       timings.samples_faint += visibility == VisibilityMode::Exact;
-      const SampledVisibilityOptions options{rays, static_cast<std::uint64_t>(s)};
-      f = culling.truncated || candidates.size() > kRayCrossover
-              ? sampled_form_factor_gradient(x, ends.n, emitter_polygon, *occluders.rays, options,
-                                             hierarchy.patch_of(receiver).surface,
-                                             hierarchy.patch_of(emitter).surface, &values.open[s])
-              : sampled_form_factor_gradient(x, ends.n, emitter_polygon, candidates, options,
-                                             &values.open[s]);
+      f = shadowed_by_rays(*this, receiver, emitter, x, ends.n, emitter_polygon, candidates,
+                           culling.truncated, static_cast<std::uint64_t>(s), &values.open[s]);
     }
     if (shared && !known) memo->add(vertex, f);
     values.value[s] = f.value;

@@ -191,6 +191,9 @@ struct LinkTimings {
   std::uint64_t samples_occluded = 0;
   std::uint64_t samples_faint = 0;
   std::uint64_t samples_shared = 0;
+  // Points of the energy correction's 3 x 3 grid (link_transport.cpp) shadowed
+  // by rays because the link's light is faint there.
+  std::uint64_t grid_points_faint = 0;
   LinkTimings& operator+=(const LinkTimings& o) {
     visibility += o.visibility;
     form_factors += o.form_factors;
@@ -199,6 +202,7 @@ struct LinkTimings {
     samples_occluded += o.samples_occluded;
     samples_faint += o.samples_faint;
     samples_shared += o.samples_shared;
+    grid_points_faint += o.grid_points_faint;
     return *this;
   }
 };
