@@ -10,7 +10,9 @@ Checked against the same solves with every sample exact (faint_share=0): in a
 lit room with a lumpy ball (faces facing each other at every distance) most
 occluded samples take rays and the light stays where it was, on the room, the
 plate's shadow and the ball; in a room lit only directly (nothing reflects)
-no sample's light is faint, so the lamp's shadows stay exact.
+no sample's light is faint, so the lamp's shadows stay exact. The energy
+correction's 3 x 3 grid (on elements whose samples are inset off a contact
+line) takes rays at its faint points as well.
 """
 
 import pathlib
@@ -39,6 +41,12 @@ class FaintSamples(unittest.TestCase):
                 # Most occluded samples' light is faint: their exact polygons go.
                 self.assertGreater(mixed.stats["samples_faint"], 0.5 * mixed.stats["samples_occluded"])
                 self.assertLess(polygons[mixed], 0.5 * polygons[exact])
+                # Refined, some elements have a corner on a contact line
+                # (inset samples, the energy correction's exact grid): the
+                # grid's points where the link's light is faint take rays.
+                self.assertEqual(exact.stats["grid_points_faint"], 0)
+                if quality > 0.0:
+                    self.assertGreater(mixed.stats["grid_points_faint"], 0)
                 for faces, side, delta in ((None, 0, 0.005), (ball, 0, 0.01)):
                     self.assertAlmostEqual(exposure(mixed, faces, side) / exposure(exact, faces, side), 1.0,
                                            delta=delta)
