@@ -282,7 +282,7 @@ bool emits(const Patch& q) {
   return luminance(q.sides[0].emission) > 0.0 || luminance(q.sides[1].emission) > 0.0;
 }
 
-// `outline`: P's, in its frame (counter-clockwise).
+// `outline_p`: P's outline, in its frame (counter-clockwise).
 Contact contact_of(const Frame& f, const std::vector<dvec2>& outline_p, double dp, const Patch& q,
                    double dq, double scene_diameter) {
   Contact out;
