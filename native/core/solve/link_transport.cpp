@@ -100,6 +100,48 @@ std::vector<Triangle>& gather_candidates(const OccluderScene& scene, const Shaft
   return candidates;
 }
 
+// Nearest and largest first: seen from a point, an occluder's image grows as
+// its area over its squared distance. Subtracted first, the large images
+// leave fewer visible pieces for the rest to cut, and where they hide the
+// whole emitter the rest are never projected. Two triangles that share an
+// edge (a mesh quad split in two, which the visible polygon takes as one
+// occluder when they come one after the other) move together.
+void order_occluders(std::vector<Triangle>& candidates, const dvec3& from) {
+  struct Unit {
+    double size;
+    std::uint32_t first, count;
+  };
+  const auto share_edge = [](const Triangle& a, const Triangle& b) {
+    int same = 0;
+    for (const dvec3& p : a.v)
+      for (const dvec3& q : b.v) same += p == q ? 1 : 0;
+    return same >= 2;
+  };
+  thread_local std::vector<Unit> units;
+  thread_local std::vector<Triangle> ordered;
+  units.clear();
+  for (std::uint32_t i = 0; i < candidates.size();) {
+    const std::uint32_t count =
+        i + 1 < candidates.size() && share_edge(candidates[i], candidates[i + 1]) ? 2 : 1;
+    double size = 0.0;
+    for (std::uint32_t k = i; k < i + count; ++k) {
+      const Triangle& t = candidates[k];
+      const dvec3 centre = (t.v[0] + t.v[1] + t.v[2]) / 3.0;
+      const double area = glm::length(glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0]));
+      size += area / std::max(glm::dot(centre - from, centre - from), 1e-300);
+    }
+    units.push_back({size, i, count});
+    i += count;
+  }
+  std::stable_sort(units.begin(), units.end(),
+                   [](const Unit& a, const Unit& b) { return a.size > b.size; });
+  ordered.clear();
+  for (const Unit& u : units)
+    ordered.insert(ordered.end(), candidates.begin() + u.first,
+                   candidates.begin() + u.first + u.count);
+  std::swap(candidates, ordered);
+}
+
 // Candidate occluders past which shadow rays go through Embree rather than
 // being tested one by one (the crossover measured near 35 candidates).
 constexpr std::size_t kRayCrossover = 32;
@@ -414,7 +456,9 @@ bool LinkEvaluator::evaluate(Link& link, LinkTimings& timings, CornerMemo* memo)
   if (culling.visibility == ShaftVisibility::hidden) return false;
 
   start = Clock::now();
-  const std::vector<Triangle>& candidates = gather_candidates(occluders.shafts, culling);
+  std::vector<Triangle>& candidates = gather_candidates(occluders.shafts, culling);
+  if (!all_by_rays && visibility == VisibilityMode::Exact)
+    order_occluders(candidates, hierarchy.centre(receiver));
   SampleValues values;
   // A corner is shared with siblings only if it is far from the emitter: close
   // to it, the sample's millionth offset towards its own element's centre
@@ -506,7 +550,8 @@ void LinkEvaluator::evaluate_emitter_siblings(std::span<Link> links, LinkTimings
   if (culling.visibility == ShaftVisibility::hidden) return;
 
   start = Clock::now();
-  const std::vector<Triangle>& candidates = gather_candidates(occluders.shafts, culling);
+  std::vector<Triangle>& candidates = gather_candidates(occluders.shafts, culling);
+  order_occluders(candidates, hierarchy.centre(receiver));
   std::array<SampleValues, 4> values;
   const LinkEnds& shared = ends[0];  // the receiver's samples are the same for all
   for (int s = 0; s < shared.ns; ++s) {
