@@ -616,6 +616,36 @@ bool project_fold(const dvec3 quad[4], Workspace& w) {
   return convex;
 }
 
+// Whether the occluder `poly` lies wholly outside the pyramid from r through
+// the box around what is still visible (w.box): its image could not touch a
+// piece, and projecting it (clipping it to the space between r and the
+// emitter) is the dearer test. Exact: the part of it the projection keeps lies
+// in that outer half-space too. With the large occluders first (link
+// transport orders them), what is visible shrinks early and most of the small
+// ones behind them fall outside.
+bool outside_visible_pyramid(std::span<const dvec3> poly, const Workspace& w) {
+  const std::size_t count = w.start.size() - 1;
+  dvec2 low = w.box[0], high = w.box[1];
+  for (std::size_t piece = 1; piece < count; ++piece) {
+    low = glm::min(low, w.box[2 * piece]);
+    high = glm::max(high, w.box[2 * piece + 1]);
+  }
+  const dvec3 corner[4] = {w.frame.to_space(low), w.frame.to_space(dvec2(high.x, low.y)),
+                           w.frame.to_space(high), w.frame.to_space(dvec2(low.x, high.y))};
+  const dvec3 middle = w.frame.to_space(0.5 * (low + high)) - w.r;
+  for (int k = 0; k < 4; ++k) {
+    dvec3 inward = glm::cross(corner[k] - w.r, corner[(k + 1) % 4] - w.r);
+    const double length = glm::length(inward);
+    if (!(length > 0.0)) continue;
+    inward /= length;
+    if (glm::dot(inward, middle) < 0.0) inward = -inward;
+    bool all_out = true;
+    for (const dvec3& v : poly) all_out &= glm::dot(inward, v - w.r) < -w.tol.space;
+    if (all_out) return true;
+  }
+  return false;
+}
+
 // Runs the whole method; the visible pieces are left in w.pieces / w.start.
 // Returns false if nothing is visible, sets `occluded` if an occluder mattered.
 bool compute_visible_pieces(const dvec3& r, const dvec3& n, std::span<const dvec3> emitter,
@@ -640,6 +670,10 @@ bool compute_visible_pieces(const dvec3& r, const dvec3& n, std::span<const dvec
     const Join join = i + 1 < occluders.size()
                           ? join_triangles(occluders[i], occluders[i + 1], w.tol.space, quad)
                           : Join::None;
+    if (outside_visible_pyramid(join == Join::None ? poly : std::span<const dvec3>(quad, 4), w)) {
+      if (join != Join::None) ++i;
+      continue;
+    }
     bool projected = false;
     if (join == Join::Folded && project_fold(quad, w)) {
       projected = true;
